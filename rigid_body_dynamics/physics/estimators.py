@@ -1,0 +1,204 @@
+"""
+Estimates from sampled, possibly irregular, gappy or reordered data.
+
+Inputs are arrays over samples: stamps ``t`` (s, header stamps, not arrival
+times), omega (N, 3) rad/s body frame, q (N, 4) x-y-z-w body -> world,
+torque (N, 3) N m body frame. :func:`sort_samples` orders the samples and
+drops duplicated stamps; every estimator calls it, so arrival order does not
+matter. Angles are unwrapped, so the sampling (and any gap) must resolve the
+motion: |rate| * (largest step between samples) < pi.
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+from scipy.integrate import cumulative_trapezoid
+
+from . import equations, quaternions
+
+
+def sort_samples(t, *arrays):
+    """Sort samples by stamp and keep the first of any duplicated stamp; returns (t, *arrays)."""
+    t = np.asarray(t, dtype=float)
+    order = np.argsort(t, kind='stable')
+    t_sorted = t[order]
+    keep = np.ones(t_sorted.shape, dtype=bool)
+    keep[1:] = np.diff(t_sorted) > 0.0
+    idx = order[keep]
+    return (t[idx],) + tuple(np.asarray(a)[idx] for a in arrays)
+
+
+@dataclass(frozen=True)
+class RateEstimate:
+    """A least-squares rate (rad/s) with its standard error, sample count and time span (s)."""
+
+    rate: float
+    stderr: float
+    samples: int
+    span: float
+
+
+def angle_rate(t, angle):
+    """
+    Rate (rad/s) of an angle (rad) from unwrap + least-squares slope on centred stamps.
+
+    numerics.md section 2.6: beats endpoint and FFT estimators on noisy,
+    irregular data. Needs at least 3 samples.
+    """
+    t, angle = sort_samples(t, angle)
+    if t.size < 3:
+        raise ValueError('need at least 3 samples to estimate a rate')
+    phi = np.unwrap(angle)
+    tc = t - t.mean()
+    design = np.stack([tc, np.ones_like(tc)], axis=1)
+    coef, _, _, _ = np.linalg.lstsq(design, phi, rcond=None)
+    resid = phi - design @ coef
+    dof = max(t.size - 2, 1)
+    stderr = math.sqrt(float(resid @ resid) / dof / float(tc @ tc))
+    return RateEstimate(float(coef[0]), stderr, int(t.size), float(t[-1] - t[0]))
+
+
+def _perp_axes(axis):
+    return (axis + 1) % 3, (axis + 2) % 3
+
+
+def body_precession_rate(t, omega, axis=2):
+    """
+    Rate (rad/s) at which omega's perpendicular part turns about body axis ``axis``.
+
+    Positive for a right-handed turn about +axis; compare with
+    theory.body_precession_rate (the seed's Omega).
+    """
+    w = np.asarray(omega, dtype=float)
+    a, b = _perp_axes(axis)
+    return angle_rate(t, np.arctan2(w[:, b], w[:, a]))
+
+
+def _basis_perpendicular(n):
+    """Unit vectors u, v with (u, v, n) right-handed."""
+    n = np.asarray(n, dtype=float)
+    n = n / np.linalg.norm(n)
+    helper = np.eye(3)[int(np.argmin(np.abs(n)))]
+    u = np.cross(n, helper)
+    u /= np.linalg.norm(u)
+    return u, np.cross(n, u), n
+
+
+def lab_precession_rate(t, q, omega, moments, axis=2):
+    """
+    Rate (rad/s) at which body axis ``axis`` precesses about the world angular momentum.
+
+    The axis' world direction R(q) e_axis is projected on a fixed basis
+    perpendicular to the mean of L_w = R(q) I omega; its azimuth is unwrapped
+    and fitted. Positive for a right-handed turn about +L. ``moments`` are
+    the principal moments in the body-axis order (kg m^2).
+    """
+    t, q, w = sort_samples(t, q, omega)
+    lw = equations.angular_momentum_world(moments, q, w)
+    u, v, _ = _basis_perpendicular(lw.mean(axis=0))
+    e = quaternions.rotate(q, np.eye(3)[axis])
+    return angle_rate(t, np.arctan2(e @ v, e @ u))
+
+
+@dataclass(frozen=True)
+class Conservation:
+    """
+    Drift since the first sample: largest relative |T - T0| / T0, ||L| - |L0|| / |L0|.
+
+    ``direction`` is the largest angle (rad) between L_w and L_w0.
+    """
+
+    energy: float
+    momentum: float
+    direction: float
+
+
+def vector_angle(a, b):
+    """Angle (rad) between vectors (..., 3) by atan2(|a x b|, a . b)."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1))
+
+
+def conservation(t, q, omega, moments):
+    """Drift of kinetic energy, |L| and the direction of L_w from sampled states (see Conservation)."""
+    t, q, w = sort_samples(t, q, omega)
+    energy = equations.kinetic_energy(moments, w)
+    lw = equations.angular_momentum_world(moments, q, w)
+    norm = np.linalg.norm(lw, axis=-1)
+    return Conservation(
+        energy=float(np.max(np.abs(energy - energy[0])) / energy[0]),
+        momentum=float(np.max(np.abs(norm - norm[0])) / norm[0]),
+        direction=float(np.max(vector_angle(lw, lw[0]))))
+
+
+@dataclass(frozen=True)
+class Balance:
+    """
+    Residuals of the balance laws under torque, largest over the samples.
+
+    ``energy``: |T - T0 - W| / max(T0, |W|) with W = int omega . tau dt;
+    ``momentum``: |L_w - L_w0 - H| / max(|L_w0|, |H|) with H = int R tau dt;
+    ``work`` (J) and ``impulse`` (N m s, world) are the final integrals.
+    """
+
+    energy: float
+    momentum: float
+    work: float
+    impulse: tuple
+
+
+def balance(t, q, omega, torque, moments):
+    """
+    Work-energy and impulse-momentum residuals from sampled torque (trapezoid rule).
+
+    Torque is body-frame. The trapezoid residual is O(dt^2) for smooth
+    torque; a step in the torque between samples costs O(dt) once.
+    """
+    t, q, w, tau = sort_samples(t, q, omega, torque)
+    energy = equations.kinetic_energy(moments, w)
+    work = cumulative_trapezoid(np.sum(w * tau, axis=-1), t, initial=0.0)
+    lw = equations.angular_momentum_world(moments, q, w)
+    impulse = cumulative_trapezoid(quaternions.rotate(q, tau), t, axis=0, initial=0.0)
+    e_scale = max(energy[0], float(np.max(np.abs(work))))
+    l_scale = max(float(np.linalg.norm(lw[0])), float(np.max(np.linalg.norm(impulse, axis=-1))))
+    e_res = np.abs(energy - energy[0] - work) / e_scale
+    l_res = np.linalg.norm(lw - lw[0] - impulse, axis=-1) / l_scale
+    return Balance(float(e_res.max()), float(l_res.max()), float(work[-1]),
+                   tuple(float(c) for c in impulse[-1]))
+
+
+def crossing_times(t, x, direction=1):
+    """
+    Stamps (s) where x crosses zero upward (direction 1), downward (-1) or either (0).
+
+    Linear interpolation between the samples that bracket each crossing.
+    """
+    t, x = sort_samples(t, x)
+    s = np.sign(x)
+    i = np.nonzero(s[:-1] * s[1:] < 0)[0]
+    if direction:
+        i = i[np.sign(x[i + 1] - x[i]) == direction]
+    return t[i] - x[i] * (t[i + 1] - t[i]) / (x[i + 1] - x[i])
+
+
+def crossing_period(t, x, direction=1):
+    """
+    Period (s) of an oscillating signal from its zero crossings (least-squares on their times).
+
+    With direction 0 (both crossings), returns the half-period spacing times 2.
+    Raises ValueError with fewer than two crossings.
+    """
+    times = crossing_times(t, x, direction)
+    if times.size < 2:
+        raise ValueError('fewer than two zero crossings: the window is too short')
+    k = np.arange(times.size)
+    slope = np.polyfit(k, times, 1)[0]
+    return float(slope * (2.0 if direction == 0 else 1.0))
+
+
+def growth_rate(t, amplitude):
+    """Exponential growth rate (1/s): least-squares slope of log|amplitude| against t."""
+    t, a = sort_samples(t, amplitude)
+    return float(np.polyfit(t - t.mean(), np.log(np.abs(a)), 1)[0])

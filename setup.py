@@ -1,0 +1,31 @@
+"""Build script for the rigid_body_dynamics ament_python package."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+package_name = 'rigid_body_dynamics'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test', 'test.*', 'benchmarks']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/config', glob('config/*.yaml')),
+        ('share/' + package_name + '/launch', glob('launch/*.py')),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='rigid_body_dynamics maintainers',
+    maintainer_email='maintainers@rigid-body-dynamics.invalid',
+    description='Rigid-body attitude simulator and motion analyser (Euler equations).',
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [
+            'rigid_body_demo = rigid_body_dynamics.demo:main',
+        ],
+    },
+)
