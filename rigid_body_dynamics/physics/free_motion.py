@@ -245,7 +245,7 @@ class BodyShape:
                     self.kind, self.axis = 'axisymmetric', axis
         if self.kind == 'asymmetric':
             self.permutation = AxisPermutation.ascending(self.moments)
-            self.sorted_moments = self.permutation.to_sorted(self.moments)
+            self.sorted_moments = self.permutation.sorted_moments(self.moments)
 
     def flow(self, q0, m0):
         """Torque-free flow from attitude q0 (x, y, z, w) and body momentum m0 (principal frame)."""
@@ -360,7 +360,9 @@ class FreeFlow:
         else:
             phi0 = math.atan2(m2 / a2, m3 / a3)
         u0 = float(ellipkinc(phi0, par.k2))
-        j0 = par.angle_integral_at_amplitude(phi0)
+        # J~ at u0 through ellipj, as at every later time: psi(0) = 0 exactly
+        # even where the round trip am(F(phi0)) loses digits (k2 -> 1).
+        j0 = par.angle_integral(u0)[0]
         base = _mul(_mul(q0, f), _conj(_align(par.family, (m1, m2, m3), g, _Math)))
         lam, family = par.lam, par.family
         sign = 1.0 if family == 'A' else -1.0

@@ -95,6 +95,10 @@ class AxisPermutation:
         quat = Rotation.from_matrix(matrix.T).as_quat()
         return cls(order, signs, tuple(float(c) for c in quat))
 
+    def sorted_moments(self, moments):
+        """The moments (a tensor's diagonal, no signs) in ascending order."""
+        return tuple(float(moments[i]) for i in self.order)
+
     def to_sorted(self, v):
         """Components of a vector (tuple) in the sorted frame."""
         o, s = self.order, self.signs

@@ -58,14 +58,15 @@ class KahanSum:
         return tuple(t + c for t, c in zip(self.total, self._comp))
 
 
-def rk4_step(inv, q, w, h, tau):
+def rk4_step(inv, q, w, h, tau, balances=False):
     """
     One classic RK4 step of Euler's equations (4.26) and dq/dt = q (x) (omega, 0) / 2.
 
     ``inv`` = (c1, c2, c3, 1/I1, 1/I2, 1/I3) with c1 = (I2 - I3) / I1 and
     cyclic; q and w are tuples; the torque tau (body, N m) is held over the
-    step. Returns the new (q, w) with q renormalised, and the RK4-weighted
-    means of omega and of q used for the work / impulse quadrature.
+    step. Returns the new (q, w) with q renormalised. With ``balances`` also
+    the step's work (J) and world impulse (N m s) by the same RK4 stages, i.e.
+    RK4 on the system augmented with dW/dt = omega . tau, dH/dt = R tau.
     """
     c1, c2, c3, j1, j2, j3 = inv
     t1, t2, t3 = tau[0] * j1, tau[1] * j2, tau[2] * j3
@@ -119,7 +120,15 @@ def rk4_step(inv, q, w, h, tau):
     z += h6 * (kz1 + 2.0 * (kz2 + kz3) + kz4)
     s += h6 * (ks1 + 2.0 * (ks2 + ks3) + ks4)
     r = 1.0 / math.sqrt(x * x + y * y + z * z + s * s)
-    return (x * r, y * r, z * r, s * r), (a, b, c)
+    if not balances:
+        return (x * r, y * r, z * r, s * r), (a, b, c)
+    tx, ty, tz = tau
+    work = h6 * (tx * (w[0] + 2.0 * (a2 + a3) + a4) + ty * (w[1] + 2.0 * (b2 + b3) + b4)
+                 + tz * (w[2] + 2.0 * (c2_ + c3_) + c4))
+    r1, r2 = _rotate(q, tau), _rotate((x2, y2, z2, s2), tau)
+    r3, r4 = _rotate((x3, y3, z3, s3), tau), _rotate((x4, y4, z4, s4), tau)
+    impulse = tuple(h6 * (e1 + 2.0 * (e2 + e3) + e4) for e1, e2, e3, e4 in zip(r1, r2, r3, r4))
+    return (x * r, y * r, z * r, s * r), (a, b, c), work, impulse
 
 
 def _rk4_constants(moments):
@@ -216,16 +225,14 @@ class RK4Integrator(Integrator):
 
     def step(self, torque=(0.0, 0.0, 0.0)):
         """Advance by dt; see :class:`Integrator`."""
-        q0, w0 = self.q, self.omega
-        q1, w1 = rk4_step(self._inv, q0, w0, self.dt, torque)
         if torque[0] != 0.0 or torque[1] != 0.0 or torque[2] != 0.0:
-            # Trapezoid in the step endpoints; RK4 itself is not a quadrature
-            # of omega . tau, so the balance residual is at truncation level.
-            h2 = 0.5 * self.dt
-            self._work.add(h2 * sum(t * (a + b) for t, a, b in zip(torque, w0, w1)))
-            r0, r1 = _rotate(q0, torque), _rotate(q1, torque)
-            self._impulse.add(*(h2 * (a + b) for a, b in zip(r0, r1)))
-        self.q, self.omega = q1, w1
+            # The balances are then at RK4's truncation level, not round-off.
+            self.q, self.omega, work, impulse = rk4_step(
+                self._inv, self.q, self.omega, self.dt, torque, balances=True)
+            self._work.add(work)
+            self._impulse.add(*impulse)
+        else:
+            self.q, self.omega = rk4_step(self._inv, self.q, self.omega, self.dt, torque)
         self.steps += 1
 
 

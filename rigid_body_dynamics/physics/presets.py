@@ -49,8 +49,8 @@ PRESETS = {p.name: p for p in (
     Preset(
         name='tennis_racket',
         description='Asymmetric body I = (1, 2, 3) spun about the intermediate axis: '
-                    'unstable, it flips end over end every few seconds (Dzhanibekov effect).',
-        moments=(1.0, 2.0, 3.0), omega0=(0.01, 2.0, 0.01), duration=40.0),
+                    'unstable, it flips end over end every 11 s (Dzhanibekov effect).',
+        moments=(1.0, 2.0, 3.0), omega0=(0.01, 2.0, 0.01), duration=60.0),
     Preset(
         name='stable_major',
         description='The same body spun near its largest-moment axis: a stable, small wobble.',

@@ -1,0 +1,40 @@
+"""Shared fixtures: reference solutions and helpers for the physics tests."""
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from rigid_body_dynamics.physics import quaternions
+from rigid_body_dynamics.physics.equations import state_rhs
+
+
+def dop853_reference(moments, omega0, q0, times, rtol=2.5e-14, torque=(0.0, 0.0, 0.0)):
+    """
+    Reference (q, omega) at ``times`` from scipy's DOP853 at tight tolerance.
+
+    At the default rtol 2.5e-14 (near scipy's floor of 100 eps) the reference
+    is good to about 1e-12 rad over 25 s at |omega| = 6 rad/s; at rtol 1e-13
+    its own error reaches 4e-12 there (measured against rtol 2.3e-14).
+
+    moments in the body-axis order (principal frame), omega0 body rad/s, q0
+    x-y-z-w body -> world, constant body torque.
+    """
+    y0 = np.concatenate([np.asarray(omega0, dtype=float), np.asarray(q0, dtype=float)])
+    scale = max(np.linalg.norm(omega0), 1e-12)
+    atol = np.array([rtol * scale] * 3 + [rtol] * 4)
+    sol = solve_ivp(lambda _t, y: state_rhs(moments, y, torque), (0.0, float(np.max(times))), y0,
+                    method='DOP853', rtol=rtol, atol=atol, t_eval=times)
+    assert sol.success
+    return quaternions.normalize(sol.y[3:].T), sol.y[:3].T
+
+
+@pytest.fixture
+def rng():
+    """A seeded generator: tests are deterministic."""
+    return np.random.default_rng(20261123)
+
+
+def random_attitude(rng):
+    """A random unit quaternion (x, y, z, w)."""
+    q = rng.normal(size=4)
+    return q / np.linalg.norm(q)
