@@ -35,8 +35,8 @@ def report(preset, integrator, duration, dt):
         lines.append(_line('body precession Omega (rad/s)',
                            estimators.body_precession_rate(run.t, run.omega, ax).rate,
                            theory.body_precession_rate(i_perp, moments[ax], body.omega0[ax]), ''))
-        lines.append(_line('lab precession |L|/I1 (rad/s)',
-                           estimators.lab_precession_rate(run.t, run.q, run.omega, moments, ax).rate,
+        lab = estimators.lab_precession_rate(run.t, run.q, run.omega, moments, ax)
+        lines.append(_line('lab precession |L|/I1 (rad/s)', lab.rate,
                            theory.lab_precession_rate(i_perp, g), ''))
     else:
         st = theory.stability(moments, body.omega0)

@@ -2,15 +2,14 @@
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
-
 from rigid_body_dynamics.physics import quaternions
 from rigid_body_dynamics.physics.equations import state_rhs
+from scipy.integrate import solve_ivp
 
 
 def dop853_reference(moments, omega0, q0, times, rtol=2.5e-14, torque=(0.0, 0.0, 0.0)):
     """
-    Reference (q, omega) at ``times`` from scipy's DOP853 at tight tolerance.
+    Return the reference (q, omega) at ``times`` from scipy's DOP853 at tight tolerance.
 
     At the default rtol 2.5e-14 (near scipy's floor of 100 eps) the reference
     is good to about 1e-12 rad over 25 s at |omega| = 6 rad/s; at rtol 1e-13
@@ -30,11 +29,11 @@ def dop853_reference(moments, omega0, q0, times, rtol=2.5e-14, torque=(0.0, 0.0,
 
 @pytest.fixture
 def rng():
-    """A seeded generator: tests are deterministic."""
+    """Return a seeded generator, so that tests are deterministic."""
     return np.random.default_rng(20261123)
 
 
 def random_attitude(rng):
-    """A random unit quaternion (x, y, z, w)."""
+    """Return a random unit quaternion (x, y, z, w)."""
     q = rng.normal(size=4)
     return q / np.linalg.norm(q)

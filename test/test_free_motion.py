@@ -1,9 +1,8 @@
 """The exact torque-free solution against DOP853 and against the closed forms."""
 
+from conftest import dop853_reference, random_attitude
 import numpy as np
 import pytest
-
-from conftest import dop853_reference, random_attitude
 from rigid_body_dynamics.physics import equations, FreeRigidBody, quaternions
 from rigid_body_dynamics.physics.free_motion import BodyShape
 
@@ -87,7 +86,8 @@ def test_near_separatrix_uses_the_fallback_and_stays_accurate(rng):
     assert np.max(quaternions.angle_between(q, q_ref)) < 1e-11
 
 
-@pytest.mark.parametrize('moments, omega0', ASYMMETRIC_CASES[:4] + [((2.0, 2.0, 3.0), (0.5, 0.2, 2))])
+@pytest.mark.parametrize('moments, omega0',
+                         ASYMMETRIC_CASES[:4] + [((2.0, 2.0, 3.0), (0.5, 0.2, 2))])
 def test_invariants_at_round_off_at_any_time(moments, omega0, rng):
     """Evaluated from the segment start, T and |L| sit at round-off even after 1e6 s."""
     q0 = random_attitude(rng)

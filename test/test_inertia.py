@@ -2,10 +2,9 @@
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
-
 from rigid_body_dynamics.physics import FreeRigidBody, Inertia, quaternions
 from rigid_body_dynamics.physics.inertia import AxisPermutation, ellipsoid_semi_axes
+from scipy.spatial.transform import Rotation
 
 
 @pytest.mark.parametrize('moments, reason', [

@@ -2,10 +2,9 @@
 
 import math
 
+from conftest import dop853_reference, random_attitude
 import numpy as np
 import pytest
-
-from conftest import dop853_reference, random_attitude
 from rigid_body_dynamics.physics import equations, FreeRigidBody, INTEGRATORS, make_integrator
 from rigid_body_dynamics.physics import quaternions
 

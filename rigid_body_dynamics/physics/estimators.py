@@ -76,7 +76,7 @@ def body_precession_rate(t, omega, axis=2):
 
 
 def _basis_perpendicular(n):
-    """Unit vectors u, v with (u, v, n) right-handed."""
+    """Return unit vectors u, v with (u, v, n) right-handed."""
     n = np.asarray(n, dtype=float)
     n = n / np.linalg.norm(n)
     helper = np.eye(3)[int(np.argmin(np.abs(n)))]
@@ -122,7 +122,7 @@ def vector_angle(a, b):
 
 
 def conservation(t, q, omega, moments):
-    """Drift of kinetic energy, |L| and the direction of L_w from sampled states (see Conservation)."""
+    """Measure the drift of T, |L| and the direction of L_w from sampled states."""
     t, q, w = sort_samples(t, q, omega)
     energy = equations.kinetic_energy(moments, w)
     lw = equations.angular_momentum_world(moments, q, w)

@@ -50,7 +50,7 @@ class _Math:
     """Elementary functions for one float: the per-step hot path."""
 
     sin, cos, sqrt, atan2 = math.sin, math.cos, math.sqrt, math.atan2
-    round = staticmethod(round)
+    nearest = staticmethod(round)
 
     @staticmethod
     def special(f, *args):
@@ -65,7 +65,7 @@ class _Math:
 class _Numpy:
     """The same functions on arrays of times."""
 
-    sin, cos, sqrt, atan2, round = np.sin, np.cos, np.sqrt, np.arctan2, np.round
+    sin, cos, sqrt, atan2, nearest = np.sin, np.cos, np.sqrt, np.arctan2, np.round
 
     @staticmethod
     def special(f, *args):
@@ -76,6 +76,7 @@ class _Numpy:
 
 def _xp(t):
     return _Math if isinstance(t, float) else _Numpy
+
 
 _mul = quaternions.mul_components
 
@@ -125,7 +126,7 @@ class PolhodeParameters:
 
     @property
     def complete_pi(self):
-        """Complete elliptic integral of the third kind Pi(n | k2) via Carlson's forms (DLMF 19.25)."""
+        """Complete elliptic integral of the third kind Pi(n | k2), Carlson forms (DLMF 19.25)."""
         if self._pi_c != self._pi_c:  # NaN: not computed yet
             self._pi_c = float(elliprf(0.0, self.kp2, 1.0)
                                + self.n / 3.0 * elliprj(0.0, self.kp2, 1.0, 1.0 - self.n))
@@ -154,7 +155,7 @@ class PolhodeParameters:
         """
         xp = _xp(u)
         two_k = 2.0 * self.K
-        j = xp.round(u / two_k)
+        j = xp.nearest(u / two_k)
         sn, cn, dn, ph = xp.ellipj(u - two_k * j, self.k2)
         value = self._j_tilde(xp, sn, cn, dn * dn, ph, j)
         parity = 1.0 - 2.0 * (j % 2.0)
@@ -194,7 +195,7 @@ def polhode_parameters(sorted_moments, m):
     p = m2 * m2 * d21 / i2 + m3 * m3 * d31 / i3
     q = m1 * m1 * d31 / i1 + m2 * m2 * d32 / i2
     s = m3 * m3 * d32 / i3 - m1 * m1 * d21 / i1
-    base = dict(moments=(i1, i2, i3), G=g, T=t, P=p, Q=q, S=s)
+    base = {'moments': (i1, i2, i3), 'G': g, 'T': t, 'P': p, 'Q': q, 'S': s}
     if abs(s) <= 4.0 * np.finfo(float).eps * g2 or p <= 0.0 or q <= 0.0:
         return PolhodeParameters(family='separatrix' if p > 0.0 and q > 0.0 else 'principal',
                                  **base)
@@ -248,7 +249,7 @@ class BodyShape:
             self.sorted_moments = self.permutation.sorted_moments(self.moments)
 
     def flow(self, q0, m0):
-        """Torque-free flow from attitude q0 (x, y, z, w) and body momentum m0 (principal frame)."""
+        """Torque-free flow from attitude q0 (x, y, z, w) and momentum m0 (principal frame)."""
         return FreeFlow(self, q0, m0)
 
 
@@ -446,7 +447,8 @@ class FreeRigidBody:
         if omega0.shape != (3,) or not np.all(np.isfinite(omega0)):
             raise ValueError(f'omega0 must be 3 finite numbers, got {omega0.tolist()}')
         if q0.shape != (4,) or not np.all(np.isfinite(q0)) or np.linalg.norm(q0) == 0.0:
-            raise ValueError(f'q0 must be 4 finite numbers (x, y, z, w), not all zero, got {q0.tolist()}')
+            raise ValueError('q0 must be 4 finite numbers (x, y, z, w), not all zero, '
+                             f'got {q0.tolist()}')
         self.omega0 = omega0
         self.q0 = q0 / np.linalg.norm(q0)
         moments = self.inertia.moments

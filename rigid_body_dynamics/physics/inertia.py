@@ -60,7 +60,8 @@ def tensor_from_six(values):
     """
     v = np.asarray(values, dtype=float).reshape(-1)
     if v.size != 6:
-        raise ValueError(f'an inertia tensor needs 6 numbers [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], got {v.size}')
+        raise ValueError('an inertia tensor needs 6 numbers [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], '
+                         f'got {v.size}')
     ixx, iyy, izz, ixy, ixz, iyz = v
     return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
 
@@ -82,7 +83,7 @@ class AxisPermutation:
 
     @classmethod
     def ascending(cls, moments):
-        """Permutation that sorts ``moments`` ascending (stable for ties)."""
+        """Build the permutation that puts ``moments`` in ascending order (stable for ties)."""
         order = tuple(int(i) for i in np.argsort(np.asarray(moments, dtype=float), kind='stable'))
         parity = 1.0
         for a, b in itertools.combinations(range(3), 2):
@@ -96,7 +97,7 @@ class AxisPermutation:
         return cls(order, signs, tuple(float(c) for c in quat))
 
     def sorted_moments(self, moments):
-        """The moments (a tensor's diagonal, no signs) in ascending order."""
+        """Return the moments (a tensor's diagonal, no signs) in ascending order."""
         return tuple(float(moments[i]) for i in self.order)
 
     def to_sorted(self, v):
@@ -131,8 +132,8 @@ class Inertia:
         if rotation is None:
             rotation = np.eye(3)
         rotation = np.array(rotation, dtype=float)
-        if rotation.shape != (3, 3) or not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-12) \
-                or np.linalg.det(rotation) < 0.0:
+        if rotation.shape != (3, 3) or np.linalg.det(rotation) < 0.0 \
+                or not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-12):
             raise ValueError('rotation must be a proper 3x3 rotation matrix')
         rotation.setflags(write=False)
         self.rotation = rotation
@@ -162,19 +163,20 @@ class Inertia:
             raise ValueError(f'inertia tensor must be symmetric, got {t.tolist()}')
         values, vectors = np.linalg.eigh(0.5 * (t + t.T))
         if np.any(values <= 0.0):
-            raise ValueError(f'inertia tensor must be positive definite; eigenvalues {values.tolist()}')
+            raise ValueError('inertia tensor must be positive definite; '
+                             f'eigenvalues {values.tolist()}')
         if np.linalg.det(vectors) < 0.0:
             vectors[:, 2] *= -1.0
         return cls(values, vectors)
 
     @property
     def tensor(self):
-        """The inertia tensor in the body frame (3x3, kg m^2)."""
+        """Return the inertia tensor in the body frame (3x3, kg m^2)."""
         return self.rotation @ np.diag(self.moments) @ self.rotation.T
 
     @property
     def is_spherical(self):
-        """True when all three moments are equal (relative tolerance EQUAL_MOMENT_RTOL)."""
+        """Tell whether all three moments are equal (relative tolerance EQUAL_MOMENT_RTOL)."""
         lo, hi = min(self.moments), max(self.moments)
         return hi - lo <= EQUAL_MOMENT_RTOL * hi
 
@@ -222,7 +224,9 @@ class Inertia:
     def attitude_to_body(self, q_world_principal):
         """Attitude of the principal frame -> attitude of the body frame (body -> world)."""
         q = np.asarray(q_world_principal, dtype=float)
-        return q if self._identity else quaternions.multiply(q, quaternions.conjugate(self.quaternion))
+        if self._identity:
+            return q
+        return quaternions.multiply(q, quaternions.conjugate(self.quaternion))
 
     def __repr__(self):
         """Readable form with the moments, e.g. Inertia([1.0, 2.0, 3.0])."""

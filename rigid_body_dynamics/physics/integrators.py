@@ -54,7 +54,7 @@ class KahanSum:
             total[i] = s
 
     def value(self):
-        """Current sums as a tuple."""
+        """Return the current sums as a tuple."""
         return tuple(t + c for t, c in zip(self.total, self._comp))
 
 
@@ -183,11 +183,11 @@ class Integrator(ABC):
         self._reset()
 
     def _reset(self):
-        """Hook for integrator-specific state after :meth:`reset`."""
+        """Reset integrator-specific state (a hook for :meth:`reset`)."""
 
     @property
     def time(self):
-        """Simulated time since the last reset (s): an integer step count times dt."""
+        """Return the simulated time since the last reset (s): integer step count times dt."""
         return self.steps * self.dt
 
     @property
@@ -268,7 +268,7 @@ class ExactIntegrator(Integrator):
         self._segment = None if flow.near_separatrix else (flow, self.steps)
 
     def _kick(self, h, torque):
-        """m += h tau at fixed attitude; accumulate its exact work and impulse."""
+        """Kick m += h tau at fixed attitude; accumulate its exact work and impulse."""
         w0 = self.omega
         i1, i2, i3 = self.moments
         w1 = (w0[0] + h * torque[0] / i1, w0[1] + h * torque[1] / i2, w0[2] + h * torque[2] / i3)

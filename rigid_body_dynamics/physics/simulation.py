@@ -39,7 +39,8 @@ class SimulationResult:
     @property
     def kinetic_energy(self):
         """T(t) = 1/2 omega . I omega (J)."""
-        return equations.kinetic_energy(self.inertia.moments, self.inertia.to_principal(self.omega))
+        principal = self.inertia.to_principal(self.omega)
+        return equations.kinetic_energy(self.inertia.moments, principal)
 
     @property
     def angular_momentum_body(self):

@@ -132,7 +132,7 @@ def nearest_axis(moments, omega):
 
 
 def stability(moments, omega):
-    """:func:`axis_stability` about the principal axis nearest omega, with omega's component on it."""
+    """Apply :func:`axis_stability` to the principal axis nearest omega."""
     axis = nearest_axis(moments, omega)
     return axis_stability(moments, axis, float(omega[axis]))
 
@@ -260,12 +260,13 @@ def mean_precession_rate(moments, omega, axis=None):
 
 
 def is_near_separatrix(moments, omega):
-    """True where the elliptic solution hands over to its numerical fallback."""
+    """Tell whether the elliptic solution hands over to its numerical fallback here."""
     _, par = _sorted_parameters(moments, omega)
     return par is not None and abs(par.separatrix_distance) < SEPARATRIX_THRESHOLD
 
 
-def chandler_wobble_period(spin_rate=2.0 * math.pi / SIDEREAL_DAY, dynamical_ellipticity=1.0 / 300.0):
+def chandler_wobble_period(spin_rate=2.0 * math.pi / SIDEREAL_DAY,
+                           dynamical_ellipticity=1.0 / 300.0):
     """
     Body-frame wobble period (s) of an oblate planet: 2 pi / Omega.
 
