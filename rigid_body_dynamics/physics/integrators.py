@@ -268,13 +268,21 @@ class ExactIntegrator(Integrator):
         self._segment = None if flow.near_separatrix else (flow, self.steps)
 
     def _kick(self, h, torque):
-        """Kick m += h tau at fixed attitude; accumulate its exact work and impulse."""
+        """
+        Kick m += h tau at fixed attitude; accumulate its exact work and impulse.
+
+        The work and impulse booked are those of the change actually made to
+        the stored omega (w1 - w0 is exact in floating point), so a rounding
+        bias of the kick (the same increment rounded the same way every step)
+        cannot separate the state from its balance.
+        """
         w0 = self.omega
         i1, i2, i3 = self.moments
         w1 = (w0[0] + h * torque[0] / i1, w0[1] + h * torque[1] / i2, w0[2] + h * torque[2] / i3)
-        self._work.add(0.5 * h * (torque[0] * (w0[0] + w1[0]) + torque[1] * (w0[1] + w1[1])
-                                  + torque[2] * (w0[2] + w1[2])))
-        self._impulse.add(*(h * c for c in _rotate(self.q, torque)))
+        dm = (i1 * (w1[0] - w0[0]), i2 * (w1[1] - w0[1]), i3 * (w1[2] - w0[2]))
+        self._work.add(0.5 * (dm[0] * (w0[0] + w1[0]) + dm[1] * (w0[1] + w1[1])
+                              + dm[2] * (w0[2] + w1[2])))
+        self._impulse.add(*_rotate(self.q, dm))
         self.omega = w1
 
     def _drift(self, h):

@@ -1,0 +1,66 @@
+"""Helpers shared by the benchmarks: machine description, errors against the exact solution."""
+
+import datetime
+import os
+import platform
+import sys
+
+import numpy as np
+from rigid_body_dynamics.physics import equations, FreeRigidBody, quaternions
+import scipy
+
+
+def machine():
+    """One line describing where and when the numbers were measured."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open('/proc/cpuinfo') as f:
+            for line in f:
+                if line.startswith('model name'):
+                    cpu = line.split(':', 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return (f'{datetime.date.today().isoformat()}, {cpu}, {os.cpu_count()} cores, '
+            f'Python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}'
+            f'{", load " + str(os.getloadavg()[0]) if hasattr(os, "getloadavg") else ""}')
+
+
+def errors(moments, omega0, q0, t, q, omega):
+    """
+    Largest errors of a sampled run (body frame = principal frame) against the exact motion.
+
+    Returns relative energy, relative |L|, L_w direction (rad) and attitude (rad).
+    """
+    m = np.asarray(moments, dtype=float)
+    t0 = equations.kinetic_energy(m, omega0)
+    l0 = equations.angular_momentum_world(m, q0, omega0)
+    energy = np.abs(equations.kinetic_energy(m, omega) / t0 - 1.0)
+    lw = equations.angular_momentum_world(m, q, omega)
+    norm = np.abs(np.linalg.norm(lw, axis=1) / np.linalg.norm(l0) - 1.0)
+    cross = np.linalg.norm(np.cross(lw, l0), axis=1)
+    direction = np.arctan2(cross, lw @ l0)
+    q_exact, _ = FreeRigidBody(moments, omega0, q0).state_at(t)
+    attitude = quaternions.angle_between(q, q_exact)
+    return float(energy.max()), float(norm.max()), float(direction.max()), float(attitude.max())
+
+
+def fmt(x):
+    """Short scientific format for a table cell."""
+    if x is None:
+        return 'n/a'
+    if x == 0.0:
+        return '0'
+    return f'{x:.1e}'
+
+
+def table(header, rows):
+    """A Markdown table."""
+    out = ['| ' + ' | '.join(header) + ' |', '|' + '---|' * len(header)]
+    out += ['| ' + ' | '.join(str(c) for c in row) + ' |' for row in rows]
+    return '\n'.join(out)
+
+
+def python_tag():
+    """The interpreter, for the record."""
+    return sys.version.split()[0]

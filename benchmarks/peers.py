@@ -1,0 +1,122 @@
+"""
+The simulators users would otherwise pick, on the same free body and steps.
+
+Optional: needs ``mujoco`` and ``bsk`` (Basilisk) from the registry,
+``.venv/bin/pip install -r benchmarks/requirements-peers.txt``. Not run in CI.
+
+Case (from issue 2): tennis racket I = (1, 2, 3) kg m^2, omega0 = (0.01, 2, 0.01)
+rad/s body, 10 ms steps, 200 s. Reported: largest relative energy error,
+final attitude error against our exact solution, wall time per simulated
+second and its ratio to our rk4 measured in the same run.
+"""
+
+import time
+
+import numpy as np
+from rigid_body_dynamics.physics import FreeRigidBody, make_integrator, quaternions
+from scipy.spatial.transform import Rotation
+
+from common import errors, fmt
+
+MOMENTS = (1.0, 2.0, 3.0)
+OMEGA0 = (0.01, 2.0, 0.01)
+Q0 = (0.0, 0.0, 0.0, 1.0)
+DT, DURATION = 0.01, 200.0
+STEPS = int(round(DURATION / DT))
+
+
+def ours(name):
+    """(seconds per simulated second, samples t, q, omega) for one of our integrators."""
+    stepper = make_integrator(name, MOMENTS, DT, Q0, OMEGA0)
+    t, q, w = [0.0], [Q0], [OMEGA0]
+    start = time.perf_counter()
+    for k in range(STEPS):
+        stepper.step()
+        if (k + 1) % 10 == 0:
+            t.append(stepper.time)
+            q.append(stepper.q)
+            w.append(stepper.omega)
+    return (time.perf_counter() - start) / DURATION, np.array(t), np.array(q), np.array(w)
+
+
+def mujoco_run(integrator):
+    """MuJoCo free joint, zero gravity, diagonal inertia; qvel[3:6] is the body-frame rate."""
+    import mujoco
+    xml = f"""
+    <mujoco>
+      <option gravity="0 0 0" timestep="{DT}" integrator="{integrator}"/>
+      <worldbody><body><freejoint/>
+        <inertial pos="0 0 0" mass="1" diaginertia="{MOMENTS[0]} {MOMENTS[1]} {MOMENTS[2]}"/>
+      </body></worldbody>
+    </mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    data.qvel[3:6] = OMEGA0
+    t, q, w = [0.0], [Q0], [OMEGA0]
+    start = time.perf_counter()
+    for k in range(STEPS):
+        mujoco.mj_step(model, data)
+        if (k + 1) % 10 == 0:
+            t.append(data.time)
+            wq = data.qpos[3:7]
+            q.append((wq[1], wq[2], wq[3], wq[0]))
+            w.append(tuple(data.qvel[3:6]))
+    return (time.perf_counter() - start) / DURATION, np.array(t), np.array(q), np.array(w)
+
+
+def basilisk_run(integrator):
+    """Basilisk spacecraft hub (MRP attitude) with an RK4 or RKF78 state integrator."""
+    from Basilisk.simulation import spacecraft, svIntegrators
+    from Basilisk.utilities import macros, RigidBodyKinematics, SimulationBaseClass
+    sim = SimulationBaseClass.SimBaseClass()
+    process = sim.CreateNewProcess('dynamics')
+    process.addTask(sim.CreateNewTask('step', macros.sec2nano(DT)))
+    craft = spacecraft.Spacecraft()
+    craft.hub.mHub = 1.0
+    craft.hub.IHubPntBc_B = [[MOMENTS[0], 0, 0], [0, MOMENTS[1], 0], [0, 0, MOMENTS[2]]]
+    craft.hub.sigma_BNInit = [[0.0], [0.0], [0.0]]
+    craft.hub.omega_BN_BInit = [[OMEGA0[0]], [OMEGA0[1]], [OMEGA0[2]]]
+    stepper = getattr(svIntegrators, integrator)(craft)
+    craft.setIntegrator(stepper)
+    sim.AddModelToTask('step', craft)
+    recorder = craft.scStateOutMsg.recorder(macros.sec2nano(10 * DT))
+    sim.AddModelToTask('step', recorder)
+    sim.InitializeSimulation()
+    sim.ConfigureStopTime(macros.sec2nano(DURATION))
+    start = time.perf_counter()
+    sim.ExecuteSimulation()
+    cost = (time.perf_counter() - start) / DURATION
+    t = recorder.times() * 1e-9
+    q = np.array([Rotation.from_matrix(np.array(RigidBodyKinematics.MRP2C(s)).T).as_quat()
+                  for s in recorder.sigma_BN])
+    return cost, t, q, np.array(recorder.omega_BN_B)
+
+
+def measure():
+    """Rows for the peer table, ours first; a peer that is not installed is said so."""
+    runs = [('rigid_body_dynamics exact', lambda: ours('exact')),
+            ('rigid_body_dynamics exact4', lambda: ours('exact4')),
+            ('rigid_body_dynamics rk4', lambda: ours('rk4')),
+            ('rigid_body_dynamics dop853', lambda: ours('dop853')),
+            ('MuJoCo, default (Euler)', lambda: mujoco_run('Euler')),
+            ('MuJoCo, RK4', lambda: mujoco_run('RK4')),
+            ('MuJoCo, implicitfast', lambda: mujoco_run('implicitfast')),
+            ('Basilisk, RK4', lambda: basilisk_run('svIntegratorRK4')),
+            ('Basilisk, RKF78', lambda: basilisk_run('svIntegratorRKF78'))]
+    rows, base = [], None
+    for label, run in runs:
+        try:
+            cost, t, q, w = run()
+        except ImportError as err:
+            rows.append([label, f'not installed ({err.name})', '', '', '', ''])
+            continue
+        energy, _, direction, _ = errors(MOMENTS, OMEGA0, Q0, t, q, w)
+        q_exact, _ = FreeRigidBody(MOMENTS, OMEGA0, Q0).state_at(t[-1])
+        final = float(quaternions.angle_between(q[-1], q_exact))
+        if label.endswith('rk4'):
+            base = cost
+        rows.append([label, fmt(energy), fmt(direction), fmt(final), f'{cost * 1e3:.2f}', cost])
+    for row in rows:
+        if isinstance(row[-1], float):
+            row[-1] = f'{row[-1] / base:.2f}' if base else 'n/a'
+    return rows
