@@ -10,13 +10,12 @@ in one shot from t = 0.
 import math
 import time
 
+from common import errors, fmt
 import numpy as np
 from rigid_body_dynamics.physics import make_integrator
 from rigid_body_dynamics.physics.equations import state_rhs
 from rigid_body_dynamics.physics.free_motion import BodyShape
 from scipy.integrate import solve_ivp
-
-from common import errors, fmt
 
 MOMENTS = (1.0, 2.0, 3.0)
 OMEGA0 = (1.0, 0.5, 6.0)
@@ -42,7 +41,7 @@ def run_stepper(name, dt, steps, sample=1000):
 
 
 def run_composed_exact(dt, steps, sample=1000):
-    """The exact flow restarted at every step (as under torque): round-off accumulation."""
+    """Restart the exact flow at every step (as under torque): round-off accumulation."""
     shape = BodyShape(MOMENTS)
     q, m = Q0, tuple(i * w for i, w in zip(MOMENTS, OMEGA0))
     n_samples = steps // sample + 1
@@ -88,11 +87,13 @@ def measure(steps):
                  per_step * 1e3, None, err))
     table_rows = []
     for name, us, sec1, sec10, err in rows:
-        table_rows.append([name, f'{us:.1f}', f'{sec1:.4f}', 'n/a' if sec10 is None else f'{sec10:.5f}',
-                           f'{sec1 / ref_cost:.2f}'] + [fmt(e) for e in err])
-    for label, method, rtol, atol in (('scipy solve_ivp RK45 (default tol)', 'RK45', 1e-3, 1e-6),
-                                      ('scipy solve_ivp DOP853 rtol 1e-9', 'DOP853', 1e-9, 1e-12),
-                                      ('scipy solve_ivp DOP853 rtol 1e-12', 'DOP853', 1e-12, 1e-15)):
+        sec10 = 'n/a' if sec10 is None else f'{sec10:.5f}'
+        table_rows.append([name, f'{us:.1f}', f'{sec1:.4f}', sec10, f'{sec1 / ref_cost:.2f}']
+                          + [fmt(e) for e in err])
+    scipy_runs = (('scipy solve_ivp RK45 (default tol)', 'RK45', 1e-3, 1e-6),
+                  ('scipy solve_ivp DOP853 rtol 1e-9', 'DOP853', 1e-9, 1e-12),
+                  ('scipy solve_ivp DOP853 rtol 1e-12', 'DOP853', 1e-12, 1e-15))
+    for label, method, rtol, atol in scipy_runs:
         cost, err = (ref_cost, ref_err) if method == 'RK45' else run_solve_ivp(
             method, rtol, atol, duration, 1.0)
         table_rows.append([label, 'adaptive', f'{cost:.4f}', f'{cost:.4f}',

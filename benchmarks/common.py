@@ -11,7 +11,7 @@ import scipy
 
 
 def machine():
-    """One line describing where and when the numbers were measured."""
+    """Describe in one line where and when the numbers were measured."""
     cpu = platform.processor() or platform.machine()
     try:
         with open('/proc/cpuinfo') as f:
@@ -21,9 +21,10 @@ def machine():
                     break
     except OSError:
         pass
+    load = f', load average {os.getloadavg()[0]:.2f}' if hasattr(os, 'getloadavg') else ''
     return (f'{datetime.date.today().isoformat()}, {cpu}, {os.cpu_count()} cores, '
-            f'Python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}'
-            f'{", load " + str(os.getloadavg()[0]) if hasattr(os, "getloadavg") else ""}')
+            f'Python {platform.python_version()}, numpy {np.__version__}, '
+            f'scipy {scipy.__version__}{load}')
 
 
 def errors(moments, omega0, q0, t, q, omega):
@@ -46,7 +47,7 @@ def errors(moments, omega0, q0, t, q, omega):
 
 
 def fmt(x):
-    """Short scientific format for a table cell."""
+    """Format a table cell in short scientific notation."""
     if x is None:
         return 'n/a'
     if x == 0.0:
@@ -55,12 +56,12 @@ def fmt(x):
 
 
 def table(header, rows):
-    """A Markdown table."""
+    """Render a Markdown table."""
     out = ['| ' + ' | '.join(header) + ' |', '|' + '---|' * len(header)]
     out += ['| ' + ' | '.join(str(c) for c in row) + ' |' for row in rows]
     return '\n'.join(out)
 
 
 def python_tag():
-    """The interpreter, for the record."""
+    """Return the interpreter version, for the record."""
     return sys.version.split()[0]

@@ -12,11 +12,10 @@ second and its ratio to our rk4 measured in the same run.
 
 import time
 
+from common import errors, fmt
 import numpy as np
 from rigid_body_dynamics.physics import FreeRigidBody, make_integrator, quaternions
 from scipy.spatial.transform import Rotation
-
-from common import errors, fmt
 
 MOMENTS = (1.0, 2.0, 3.0)
 OMEGA0 = (0.01, 2.0, 0.01)
@@ -40,7 +39,7 @@ def ours(name):
 
 
 def mujoco_run(integrator):
-    """MuJoCo free joint, zero gravity, diagonal inertia; qvel[3:6] is the body-frame rate."""
+    """Run MuJoCo: free joint, zero gravity, diagonal inertia; qvel[3:6] is the body rate."""
     import mujoco
     xml = f"""
     <mujoco>
@@ -65,7 +64,7 @@ def mujoco_run(integrator):
 
 
 def basilisk_run(integrator):
-    """Basilisk spacecraft hub (MRP attitude) with an RK4 or RKF78 state integrator."""
+    """Run a Basilisk spacecraft hub (MRP attitude) with an RK4 or RKF78 integrator."""
     from Basilisk.simulation import spacecraft, svIntegrators
     from Basilisk.utilities import macros, RigidBodyKinematics, SimulationBaseClass
     sim = SimulationBaseClass.SimBaseClass()

@@ -9,11 +9,10 @@ changes by a few percent, as in a controller's manoeuvre.
 import math
 import time
 
-import numpy as np
-from rigid_body_dynamics.physics import equations, make_integrator
-
 from accuracy import MOMENTS, OMEGA0, Q0
 from common import fmt
+import numpy as np
+from rigid_body_dynamics.physics import equations, make_integrator
 
 
 def measure(steps):
@@ -34,5 +33,6 @@ def measure(steps):
         l1 = equations.angular_momentum_world(m, np.array(stepper.q), np.array(stepper.omega))
         rows.append([name, f'{per_step * 1e6:.1f}', fmt(abs(t1 - t0) / t0),
                      fmt(abs(t1 - t0 - stepper.work) / t0),
-                     fmt(np.linalg.norm(l1 - l0 - np.array(stepper.impulse)) / np.linalg.norm(l0))])
+                     fmt(np.linalg.norm(l1 - l0 - np.array(stepper.impulse))
+                         / np.linalg.norm(l0))])
     return rows

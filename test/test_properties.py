@@ -50,11 +50,13 @@ def test_exact_flow_conserves_energy_and_momentum(case):
     t = np.array([0.7, 33.0, 200.0])
     q, w = FreeRigidBody(moments, omega, q0).state_at(t)
     m = np.array(moments)
+    # the near-separatrix fallback is DOP853 at rtol 1e-13: invariants to its tolerance
+    rtol = 1e-13 if not theory.is_near_separatrix(moments, omega) else 2e-12
     t0 = equations.kinetic_energy(m, omega)
-    np.testing.assert_allclose(equations.kinetic_energy(m, w), t0, rtol=1e-13)
+    np.testing.assert_allclose(equations.kinetic_energy(m, w), t0, rtol=rtol)
     l0 = equations.angular_momentum_world(m, q0, omega)
     lw = equations.angular_momentum_world(m, q, w)
-    np.testing.assert_allclose(np.linalg.norm(lw, axis=1), np.linalg.norm(l0), rtol=1e-13)
+    np.testing.assert_allclose(np.linalg.norm(lw, axis=1), np.linalg.norm(l0), rtol=rtol)
 
 
 @settings(max_examples=25, deadline=None)
