@@ -26,6 +26,7 @@ setup(
     entry_points={
         'console_scripts': [
             'rigid_body_demo = rigid_body_dynamics.demo:main',
+            'attitude_simulator = rigid_body_dynamics.nodes.simulator:main',
         ],
     },
 )

@@ -1,0 +1,1 @@
+"""Thin rclpy nodes over :mod:`rigid_body_dynamics.physics`."""

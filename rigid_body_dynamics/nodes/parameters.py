@@ -1,0 +1,52 @@
+"""
+Declaring and validating node parameters: descriptors with units and ranges.
+
+Numbers are declared with dynamic typing so that ``-p inertia:=[1,2,3]`` (an
+integer array) is accepted and converted, instead of failing on
+``INTEGER_ARRAY`` against ``DOUBLE_ARRAY`` (ros2/rclcpp#979); the values are
+then checked here, with a reason for every refusal.
+"""
+
+import math
+
+from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
+
+
+class ConfigurationError(ValueError):
+    """A parameter value the node cannot run with; the message says why."""
+
+
+def descriptor(description, read_only=False, low=None, high=None, constraints='',
+               dynamic_typing=False):
+    """ParameterDescriptor with a description (units!), optional range and constraints."""
+    desc = ParameterDescriptor(description=description, read_only=read_only,
+                               additional_constraints=constraints,
+                               dynamic_typing=dynamic_typing)
+    if low is not None:
+        desc.floating_point_range = [FloatingPointRange(from_value=float(low),
+                                                        to_value=float(high), step=0.0)]
+    return desc
+
+
+def as_float(name, value, low=-math.inf, high=math.inf):
+    """Return ``value`` as a finite float within [low, high], or raise ConfigurationError."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ConfigurationError(f'{name} must be a number, got {value!r}')
+    value = float(value)
+    if not math.isfinite(value):
+        raise ConfigurationError(f'{name} must be finite, got {value!r}')
+    if not low <= value <= high:
+        raise ConfigurationError(f'{name} must be within [{low:g}, {high:g}], got {value:g}')
+    return value
+
+
+def as_vector(name, value, size):
+    """Return ``value`` as a tuple of ``size`` finite floats, or raise ConfigurationError."""
+    try:
+        items = list(value)
+    except TypeError:
+        raise ConfigurationError(f'{name} must be a list of {size} numbers, got {value!r}') \
+            from None
+    if len(items) != size:
+        raise ConfigurationError(f'{name} must have {size} numbers, got {len(items)}')
+    return tuple(as_float(f'{name}[{i}]', v) for i, v in enumerate(items))
