@@ -1,4 +1,6 @@
-"""Shared fixtures: reference solutions and helpers for the physics tests."""
+"""Shared fixtures: reference solutions, a ROS domain per session, node processes."""
+
+import os
 
 import numpy as np
 import pytest
@@ -37,3 +39,58 @@ def random_attitude(rng):
     """Return a random unit quaternion (x, y, z, w)."""
     q = rng.normal(size=4)
     return q / np.linalg.norm(q)
+
+
+@pytest.fixture(scope='session', autouse=True)
+def ros_domain(tmp_path_factory):
+    """
+    Reserve a free ROS_DOMAIN_ID for this session and keep DDS on this machine.
+
+    Sets the environment that every node process inherits and that this
+    process's rclpy contexts read: ROS_DOMAIN_ID, localhost-only discovery,
+    and ROS_LOG_DIR in a temporary folder.
+    """
+    from domain_coordinator import domain_id
+    saved = {k: os.environ.get(k) for k in
+             ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_LOG_DIR',
+              'ROS_LOCALHOST_ONLY')}
+    with domain_id() as domain:
+        os.environ['ROS_DOMAIN_ID'] = str(domain)
+        os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+        os.environ['ROS_LOG_DIR'] = str(tmp_path_factory.mktemp('ros_log'))
+        os.environ.pop('ROS_LOCALHOST_ONLY', None)
+        yield domain
+    for key, value in saved.items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
+
+
+@pytest.fixture
+def probe():
+    """Give the test an rclpy node in its own Context, torn down after the test."""
+    from ros_harness import Probe
+    p = Probe()
+    yield p
+    p.close()
+
+
+@pytest.fixture
+def launch(tmp_path):
+    """
+    Start node processes: call the fixture with a module, ros args and a name.
+
+    Every process still running at the end of the test is stopped with SIGINT.
+    """
+    from ros_harness import NodeProcess
+    started = []
+
+    def start(module, *ros_args, name='node'):
+        proc = NodeProcess(module, ros_args, log_dir=str(tmp_path), name=name)
+        started.append(proc)
+        return proc
+    yield start
+    for proc in started:
+        if proc.proc.poll() is None:
+            proc.stop()

@@ -159,3 +159,21 @@ def test_dop853_restarts_when_torque_changes():
     for k in range(10000):
         fine.step((0.0, 0.0, 0.5) if k < 5000 else (0.0, 0.0, 0.0))
     assert float(quaternions.angle_between(stepper.q, fine.q)) < 1e-10
+
+
+@pytest.mark.parametrize('name, tol', [('exact', 1e-13), ('exact4', 1e-13), ('rk4', 1e-9),
+                                       ('dop853', 1e-10)])
+def test_world_fixed_torque_gives_exactly_its_impulse(name, tol, rng):
+    """A torque held fixed in the world frame changes L_w by tau_w t, whatever the body does."""
+    q0 = random_attitude(rng)
+    tau_w = (0.05, -0.02, 0.04)
+    stepper = make_integrator(name, MOMENTS, 1e-3, q0, OMEGA0)
+    for _ in range(2000):
+        stepper.step((0.0, 0.0, 0.0), tau_w)
+    _, l0 = invariants(MOMENTS, q0, OMEGA0)
+    t1, l1 = invariants(MOMENTS, stepper.q, stepper.omega)
+    expected = l0 + np.array(tau_w) * stepper.time
+    assert np.linalg.norm(l1 - expected) / np.linalg.norm(l0) < tol
+    np.testing.assert_allclose(stepper.impulse, np.array(tau_w) * stepper.time, rtol=1e-9)
+    t0 = invariants(MOMENTS, q0, OMEGA0)[0]
+    assert abs(t1 - t0 - stepper.work) / t0 < max(tol, 1e-11)

@@ -72,5 +72,5 @@ def status(name, level, message, values, hardware_id='none'):
 
 
 def status_values(msg):
-    """Mapping key -> string value of a DiagnosticStatus."""
+    """Return the key -> string value mapping of a DiagnosticStatus."""
     return {kv.key: kv.value for kv in msg.values}

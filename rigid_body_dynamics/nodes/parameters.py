@@ -18,7 +18,7 @@ class ConfigurationError(ValueError):
 
 def descriptor(description, read_only=False, low=None, high=None, constraints='',
                dynamic_typing=False):
-    """ParameterDescriptor with a description (units!), optional range and constraints."""
+    """Build a ParameterDescriptor: description (with units), optional range, constraints."""
     desc = ParameterDescriptor(description=description, read_only=read_only,
                                additional_constraints=constraints,
                                dynamic_typing=dynamic_typing)

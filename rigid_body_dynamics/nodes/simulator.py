@@ -25,15 +25,14 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import InertiaStamped, QuaternionStamped, Vector3Stamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
+from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy)
 from rclpy.qos_overriding_options import QoSOverridingOptions
-from rcl_interfaces.msg import SetParametersResult
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import Imu
 from std_msgs.msg import Float64
@@ -41,9 +40,10 @@ from std_srvs.srv import SetBool, Trigger
 
 from . import conversions as conv
 from .parameters import as_float, as_vector, ConfigurationError, descriptor
-from ..physics import equations, Inertia, INTEGRATORS, make_integrator, presets, quaternions
+from ..physics import Inertia, INTEGRATORS, make_integrator, presets, quaternions
 
 NODE_NAME = 'attitude_simulator'
+_ZERO = (0.0, 0.0, 0.0)
 _NS = 1_000_000_000
 #: Wall time the pacing may fall behind before the backlog is dropped (s).
 MAX_LAG = 0.25
@@ -128,7 +128,7 @@ class AttitudeSimulator(Node):
             'Principal moments [I1, I2, I3] (kg m^2), body = principal frame; positive and '
             'satisfying I1 + I2 >= I3 and permutations. A change keeps attitude and angular '
             'velocity.', **num))
-        self.declare_parameter('inertia_tensor', Parameter.Type.DOUBLE_ARRAY, descriptor(
+        self.declare_parameter('inertia_tensor', None, descriptor(
             'Optional full tensor [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] (kg m^2, tensor elements as in '
             'URDF) in the body frame; overrides inertia. Unset by default.', **num))
         self._dynamic.append('inertia_tensor')
@@ -300,7 +300,7 @@ class AttitudeSimulator(Node):
         self._paused = False
         self._command = None
         self._timed_out = False
-        self._last_torque = (0.0, 0.0, 0.0)
+        self._last_torque = _ZERO
         self._missed = 0
         self._stats = (time.monotonic_ns(), 0)
         self._baseline()
@@ -368,21 +368,25 @@ class AttitudeSimulator(Node):
                                                time.monotonic_ns())
 
     def _torque_now(self, now_ns):
-        """Principal-frame torque for the next step: held command, timeout, world rotation."""
+        """
+        Torque for the next step: (principal-frame part, world-frame part or None).
+
+        A world-frame command stays fixed in the world over the step (the
+        integrator rotates it into the body as the body turns).
+        """
         cmd = self._command
         if cmd is None:
-            return (0.0, 0.0, 0.0)
+            return _ZERO, None
         if self._timeout_ns and now_ns - cmd.received_ns > self._timeout_ns:
             if not self._timed_out:
                 self._timed_out = True
                 self.get_logger().info('torque command timed out: torque is zero until the '
                                        'next command')
-            return (0.0, 0.0, 0.0)
+            return _ZERO, None
         self._timed_out = False
         if cmd.world:
-            q = self._stepper.q
-            return quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), cmd.vector)
-        return cmd.principal
+            return _ZERO, cmd.vector
+        return cmd.principal, None
 
     # ------------------------------------------------------------------ stepping
     def start(self):
@@ -439,9 +443,12 @@ class AttitudeSimulator(Node):
 
     def _advance(self, now_ns):
         """One integration step, publishing when a publish tick falls on it."""
-        torque = self._torque_now(now_ns)
-        self._stepper.step(torque)
+        torque, torque_world = self._torque_now(now_ns)
+        self._stepper.step(torque, torque_world)
         self._steps += 1
+        if torque_world is not None:
+            q = self._stepper.q
+            torque = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), torque_world)
         if torque[0] or torque[1] or torque[2]:
             self._baseline()
         self._last_torque = torque

@@ -2,7 +2,10 @@
 Fixed-step attitude integrators behind one protocol.
 
 Every integrator advances the state (q, omega) of one body by a fixed step dt
-(s) under a torque held constant over the step (body frame, N m). The state is
+(s) under a torque held constant over the step: ``torque`` fixed in the body
+frame and, optionally, ``torque_world`` fixed in the world frame (both N m;
+the world part is rotated into the body wherever the method evaluates the
+torque, so its impulse is exactly torque_world dt for the kick scheme). The state is
 kept in the principal frame: ``moments`` are the principal moments (kg m^2)
 in the order of the body axes, omega (rad/s) is body-frame, q (x, y, z, w)
 rotates body vectors into the world frame.
@@ -58,22 +61,33 @@ class KahanSum:
         return tuple(t + c for t, c in zip(self.total, self._comp))
 
 
-def rk4_step(inv, q, w, h, tau, balances=False):
+def _stage_torque(tau, tau_world, q):
+    """Body torque at attitude q: tau + R(q)^T tau_world (N m)."""
+    x, y, z, w = q
+    return tuple(a + b for a, b in zip(tau, _rotate((-x, -y, -z, w), tau_world)))
+
+
+def rk4_step(inv, q, w, h, tau, balances=False, tau_world=None):
     """
     One classic RK4 step of Euler's equations (4.26) and dq/dt = q (x) (omega, 0) / 2.
 
     ``inv`` = (c1, c2, c3, 1/I1, 1/I2, 1/I3) with c1 = (I2 - I3) / I1 and
     cyclic; q and w are tuples; the torque tau (body, N m) is held over the
-    step. Returns the new (q, w) with q renormalised. With ``balances`` also
-    the step's work (J) and world impulse (N m s) by the same RK4 stages, i.e.
-    RK4 on the system augmented with dW/dt = omega . tau, dH/dt = R tau.
+    step, and ``tau_world`` (world, N m), if given, is held fixed in the world
+    frame (rotated into the body at every stage). Returns the new (q, w) with
+    q renormalised. With ``balances`` also the step's work (J) and world
+    impulse (N m s) by the same RK4 stages, i.e. RK4 on the system augmented
+    with dW/dt = omega . tau, dH/dt = R tau.
     """
     c1, c2, c3, j1, j2, j3 = inv
-    t1, t2, t3 = tau[0] * j1, tau[1] * j2, tau[2] * j3
     x, y, z, s = q
     a, b, c = w
     hh = 0.5 * h
+    stage_tau = [tau] * 4
     # stage 1
+    if tau_world is not None:
+        stage_tau[0] = _stage_torque(tau, tau_world, q)
+    t1, t2, t3 = stage_tau[0][0] * j1, stage_tau[0][1] * j2, stage_tau[0][2] * j3
     ka1 = c1 * b * c + t1
     kb1 = c2 * c * a + t2
     kc1 = c3 * a * b + t3
@@ -84,6 +98,9 @@ def rk4_step(inv, q, w, h, tau, balances=False):
     # stage 2
     a2, b2, c2_ = a + hh * ka1, b + hh * kb1, c + hh * kc1
     x2, y2, z2, s2 = x + hh * kx1, y + hh * ky1, z + hh * kz1, s + hh * ks1
+    if tau_world is not None:
+        stage_tau[1] = _stage_torque(tau, tau_world, (x2, y2, z2, s2))
+        t1, t2, t3 = stage_tau[1][0] * j1, stage_tau[1][1] * j2, stage_tau[1][2] * j3
     ka2 = c1 * b2 * c2_ + t1
     kb2 = c2 * c2_ * a2 + t2
     kc2 = c3 * a2 * b2 + t3
@@ -94,6 +111,9 @@ def rk4_step(inv, q, w, h, tau, balances=False):
     # stage 3
     a3, b3, c3_ = a + hh * ka2, b + hh * kb2, c + hh * kc2
     x3, y3, z3, s3 = x + hh * kx2, y + hh * ky2, z + hh * kz2, s + hh * ks2
+    if tau_world is not None:
+        stage_tau[2] = _stage_torque(tau, tau_world, (x3, y3, z3, s3))
+        t1, t2, t3 = stage_tau[2][0] * j1, stage_tau[2][1] * j2, stage_tau[2][2] * j3
     ka3 = c1 * b3 * c3_ + t1
     kb3 = c2 * c3_ * a3 + t2
     kc3 = c3 * a3 * b3 + t3
@@ -104,6 +124,9 @@ def rk4_step(inv, q, w, h, tau, balances=False):
     # stage 4
     a4, b4, c4 = a + h * ka3, b + h * kb3, c + h * kc3
     x4, y4, z4, s4 = x + h * kx3, y + h * ky3, z + h * kz3, s + h * ks3
+    if tau_world is not None:
+        stage_tau[3] = _stage_torque(tau, tau_world, (x4, y4, z4, s4))
+        t1, t2, t3 = stage_tau[3][0] * j1, stage_tau[3][1] * j2, stage_tau[3][2] * j3
     ka4 = c1 * b4 * c4 + t1
     kb4 = c2 * c4 * a4 + t2
     kc4 = c3 * a4 * b4 + t3
@@ -122,12 +145,13 @@ def rk4_step(inv, q, w, h, tau, balances=False):
     r = 1.0 / math.sqrt(x * x + y * y + z * z + s * s)
     if not balances:
         return (x * r, y * r, z * r, s * r), (a, b, c)
-    tx, ty, tz = tau
-    work = h6 * (tx * (w[0] + 2.0 * (a2 + a3) + a4) + ty * (w[1] + 2.0 * (b2 + b3) + b4)
-                 + tz * (w[2] + 2.0 * (c2_ + c3_) + c4))
-    r1, r2 = _rotate(q, tau), _rotate((x2, y2, z2, s2), tau)
-    r3, r4 = _rotate((x3, y3, z3, s3), tau), _rotate((x4, y4, z4, s4), tau)
-    impulse = tuple(h6 * (e1 + 2.0 * (e2 + e3) + e4) for e1, e2, e3, e4 in zip(r1, r2, r3, r4))
+    omegas = (w, (a2, b2, c2_), (a3, b3, c3_), (a4, b4, c4))
+    quats = (q, (x2, y2, z2, s2), (x3, y3, z3, s3), (x4, y4, z4, s4))
+    weights = (h6, 2.0 * h6, 2.0 * h6, h6)
+    work = sum(wt * (tq[0] * om[0] + tq[1] * om[1] + tq[2] * om[2])
+               for wt, tq, om in zip(weights, stage_tau, omegas))
+    rotated = [_rotate(qs, tq) for qs, tq in zip(quats, stage_tau)]
+    impulse = tuple(sum(wt * r_[i] for wt, r_ in zip(weights, rotated)) for i in range(3))
     return (x * r, y * r, z * r, s * r), (a, b, c), work, impulse
 
 
@@ -211,8 +235,12 @@ class Integrator(ABC):
         return 0.5 * sum(i * w * w for i, w in zip(self.moments, self.omega))
 
     @abstractmethod
-    def step(self, torque=(0.0, 0.0, 0.0)):
-        """Advance by dt with ``torque`` (body frame, N m) held over the step."""
+    def step(self, torque=(0.0, 0.0, 0.0), torque_world=None):
+        """
+        Advance by one step dt, the torque held in the body frame over it (N m).
+
+        ``torque_world`` (N m), if not None, is held fixed in the world frame.
+        """
 
 
 class RK4Integrator(Integrator):
@@ -223,12 +251,15 @@ class RK4Integrator(Integrator):
     def _reset(self):
         self._inv = _rk4_constants(self.moments)
 
-    def step(self, torque=(0.0, 0.0, 0.0)):
+    def step(self, torque=(0.0, 0.0, 0.0), torque_world=None):
         """Advance by dt; see :class:`Integrator`."""
-        if torque[0] != 0.0 or torque[1] != 0.0 or torque[2] != 0.0:
+        if torque_world is not None and not any(torque_world):
+            torque_world = None
+        if torque_world is not None or torque[0] != 0.0 or torque[1] != 0.0 or torque[2] != 0.0:
             # The balances are then at RK4's truncation level, not round-off.
             self.q, self.omega, work, impulse = rk4_step(
-                self._inv, self.q, self.omega, self.dt, torque, balances=True)
+                self._inv, self.q, self.omega, self.dt, torque, balances=True,
+                tau_world=torque_world)
             self._work.add(work)
             self._impulse.add(*impulse)
         else:
@@ -267,7 +298,7 @@ class ExactIntegrator(Integrator):
         flow = self._shape.flow(self.q, m)
         self._segment = None if flow.near_separatrix else (flow, self.steps)
 
-    def _kick(self, h, torque):
+    def _kick(self, h, torque, torque_world=None):
         """
         Kick m += h tau at fixed attitude; accumulate its exact work and impulse.
 
@@ -276,6 +307,8 @@ class ExactIntegrator(Integrator):
         bias of the kick (the same increment rounded the same way every step)
         cannot separate the state from its balance.
         """
+        if torque_world is not None:
+            torque = _stage_torque(torque, torque_world, self.q)
         w0 = self.omega
         i1, i2, i3 = self.moments
         w1 = (w0[0] + h * torque[0] / i1, w0[1] + h * torque[1] / i2, w0[2] + h * torque[2] / i3)
@@ -304,10 +337,12 @@ class ExactIntegrator(Integrator):
         self.q = tuple(c * r for c in q)
         self.omega = tuple(float(mi) / i for mi, i in zip(m, self.moments))
 
-    def step(self, torque=(0.0, 0.0, 0.0)):
+    def step(self, torque=(0.0, 0.0, 0.0), torque_world=None):
         """Advance by dt; see :class:`ExactIntegrator`."""
         h = self.dt
-        if torque[0] == 0.0 and torque[1] == 0.0 and torque[2] == 0.0:
+        if torque_world is not None and not any(torque_world):
+            torque_world = None
+        if torque_world is None and torque[0] == 0.0 and torque[1] == 0.0 and torque[2] == 0.0:
             if self._segment is None:
                 self._start_segment()
             if self._segment is not None:
@@ -319,9 +354,9 @@ class ExactIntegrator(Integrator):
         else:
             self._segment = None
             for flow_frac, kick_frac in self._stages:
-                self._kick(kick_frac * h, torque)
+                self._kick(kick_frac * h, torque, torque_world)
                 self._drift(flow_frac * h)
-            self._kick(self._last_kick * h, torque)
+            self._kick(self._last_kick * h, torque, torque_world)
         self.steps += 1
 
 
@@ -360,30 +395,33 @@ class DOP853Integrator(Integrator):
         self._solver = None
         self._torque = None
 
-    def _restart(self, torque):
+    def _restart(self, torque, torque_world):
         moments = np.array(self.moments)
-        tau = np.array(torque, dtype=float)
+        tau_body = tuple(torque)
 
         def rhs(_t, y):
+            q = tuple(y[3:7])
+            tau = tau_body if torque_world is None else _stage_torque(tau_body, torque_world, q)
             d = state_rhs(moments, y[:7], tau)
-            r = _rotate(tuple(y[3:7]), tuple(tau))
-            return np.concatenate([d, [np.dot(y[:3], tau)], r])
+            return np.concatenate([d, [np.dot(y[:3], tau)], _rotate(q, tau)])
 
         y0 = np.concatenate([self.omega, self.q, np.zeros(4)])
         scale = max(math.sqrt(sum(c * c for c in self.omega)), 1e-9)
         big = max(scale * max(self.moments), 1e-9)
         atol = np.array([1e-12 * scale] * 3 + [1e-12] * 4 + [1e-12 * big] * 4)
         self._solver = DOP853(rhs, 0.0, y0, np.inf, rtol=self.rtol, atol=atol)
-        self._torque = tuple(torque)
+        self._torque = (tuple(torque), torque_world)
         self._t0 = self.steps
         self._base = (self.work, self.impulse)
         self._dense = None
 
-    def step(self, torque=(0.0, 0.0, 0.0)):
+    def step(self, torque=(0.0, 0.0, 0.0), torque_world=None):
         """Advance by dt; see :class:`DOP853Integrator`."""
         torque = tuple(float(c) for c in torque)
-        if self._solver is None or torque != self._torque:
-            self._restart(torque)
+        if torque_world is not None:
+            torque_world = tuple(float(c) for c in torque_world)
+        if self._solver is None or (torque, torque_world) != self._torque:
+            self._restart(torque, torque_world)
         self.steps += 1
         t = (self.steps - self._t0) * self.dt
         solver = self._solver

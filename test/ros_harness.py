@@ -1,0 +1,123 @@
+"""
+Helpers for tests that talk to the nodes over real topics.
+
+Nodes start as separate processes the way a user starts them
+(``python -m rigid_body_dynamics.nodes.<name> --ros-args ...``), in the DDS
+domain the session fixture reserved, with discovery kept on this machine. The
+test side is an rclpy node in its own Context. Every wait has a deadline.
+"""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+#: Subscriber QoS for the tests: reliable with a deep queue, so nothing is dropped.
+DEEP = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10000,
+                  reliability=ReliabilityPolicy.RELIABLE)
+LATCHED = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
+                     reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+class NodeProcess:
+    """A node started as its own process; ``stop()`` sends SIGINT and returns the exit code."""
+
+    def __init__(self, module, ros_args=(), log_dir=None, name='node'):
+        self.log_path = os.path.join(log_dir or os.environ['ROS_LOG_DIR'], f'{name}.log')
+        self._log = open(self.log_path, 'w')
+        self.proc = subprocess.Popen(
+            [sys.executable, '-m', module, '--ros-args', *ros_args],
+            stdout=self._log, stderr=subprocess.STDOUT, env=os.environ.copy())
+
+    def output(self):
+        """Everything the process printed so far."""
+        if not self._log.closed:
+            self._log.flush()
+        with open(self.log_path) as f:
+            return f.read()
+
+    def stop(self, timeout=10.0):
+        """SIGINT, then wait; kill after ``timeout`` s. Returns (exit code, seconds taken)."""
+        start = time.monotonic()
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGINT)
+            try:
+                self.proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(5.0)
+        self._log.close()
+        return self.proc.returncode, time.monotonic() - start
+
+    def wait(self, timeout):
+        """Wait for the process to end by itself; returns its exit code."""
+        code = self.proc.wait(timeout)
+        self._log.close()
+        return code
+
+
+class Probe:
+    """A test-side node in its own Context: subscribe, publish, call services, with deadlines."""
+
+    def __init__(self, name='probe'):
+        self.context = Context()
+        rclpy.init(context=self.context)
+        self.node = rclpy.create_node(name, context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.messages = {}
+
+    def subscribe(self, msg_type, topic, qos=DEEP):
+        """Collect every message on ``topic`` into ``self.messages[topic]``; returns that list."""
+        store = self.messages.setdefault(topic, [])
+        self.node.create_subscription(msg_type, topic, store.append, qos)
+        return store
+
+    def spin_until(self, predicate, timeout, what='condition'):
+        """Spin until ``predicate()`` holds; AssertionError naming ``what`` after ``timeout``."""
+        deadline = time.monotonic() + timeout
+        while not predicate():
+            if time.monotonic() > deadline:
+                raise AssertionError(f'timed out after {timeout} s waiting for {what}')
+            self.executor.spin_once(timeout_sec=0.02)
+
+    def spin_for(self, seconds):
+        """Spin for a fixed time (collecting messages)."""
+        deadline = time.monotonic() + seconds
+        while time.monotonic() < deadline:
+            self.executor.spin_once(timeout_sec=0.02)
+
+    def wait_for(self, topic, count=1, timeout=20.0):
+        """Spin until ``count`` messages arrived on ``topic``; returns the list."""
+        store = self.messages[topic]
+        self.spin_until(lambda: len(store) >= count, timeout, f'{count} messages on {topic}')
+        return store
+
+    def publisher(self, msg_type, topic, qos=10, subscribers=1, timeout=20.0):
+        """Create a publisher and return it once ``subscribers`` subscriptions matched it."""
+        pub = self.node.create_publisher(msg_type, topic, qos)
+        self.spin_until(lambda: pub.get_subscription_count() >= subscribers, timeout,
+                        f'a subscriber on {topic}')
+        return pub
+
+    def call(self, srv_type, name, request, timeout=20.0):
+        """Call a service and return its response."""
+        client = self.node.create_client(srv_type, name)
+        self.spin_until(client.service_is_ready, timeout, f'service {name}')
+        future = client.call_async(request)
+        self.spin_until(future.done, timeout, f'the response of {name}')
+        self.node.destroy_client(client)
+        return future.result()
+
+    def close(self):
+        """Tear down node, executor and context."""
+        self.executor.shutdown()
+        self.node.destroy_node()
+        rclpy.shutdown(context=self.context)

@@ -1,0 +1,292 @@
+"""
+attitude_simulator over real topics: the node runs as its own process.
+
+Runs use ``publish_clock:=true`` so that header stamps are the simulated time
+from 0, which lets every received state be compared with the exact solution
+at its own stamp whatever the test happened to miss while discovering.
+"""
+
+import math
+
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import InertiaStamped, Vector3Stamped, WrenchStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+import pytest
+from rcl_interfaces.srv import SetParameters
+from rclpy.parameter import Parameter
+from rclpy.qos import qos_profile_sensor_data
+from rigid_body_dynamics.nodes.conversions import quaternion_array, status_values, vector_array
+from rigid_body_dynamics.physics import FreeRigidBody, Inertia, quaternions
+from ros_harness import LATCHED
+from rosgraph_msgs.msg import Clock
+from std_srvs.srv import SetBool, Trigger
+
+SIM = 'rigid_body_dynamics.nodes.simulator'
+NODE = '/attitude_simulator'
+
+
+def stamp(msg):
+    """Header stamp in seconds."""
+    return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+
+
+def odom_arrays(msgs):
+    """(t, q, omega) arrays from Odometry messages."""
+    t = np.array([stamp(m) for m in msgs])
+    q = np.array([quaternion_array(m.pose.pose.orientation) for m in msgs])
+    w = np.array([vector_array(m.twist.twist.angular) for m in msgs])
+    return t, q, w
+
+
+def vectors(msgs):
+    """(t, v) arrays from Vector3Stamped messages."""
+    return np.array([stamp(m) for m in msgs]), np.array([vector_array(m.vector) for m in msgs])
+
+
+def assert_exact(msgs, moments, omega0, q0=(0.0, 0.0, 0.0, 1.0), tol=1e-9):
+    """Every Odometry message matches the exact torque-free motion at its stamp."""
+    t, q, w = odom_arrays(msgs)
+    q_ref, w_ref = FreeRigidBody(moments, omega0, q0).state_at(t)
+    assert np.max(quaternions.angle_between(q, q_ref)) <= tol
+    assert np.max(np.abs(w - w_ref)) <= tol * np.linalg.norm(omega0)
+
+
+def set_params(probe, **values):
+    """Set parameters through the node's service; returns the SetParametersResult list."""
+    request = SetParameters.Request(parameters=[
+        Parameter(name, value=value).to_parameter_msg() for name, value in values.items()])
+    return probe.call(SetParameters, f'{NODE}/set_parameters', request).results
+
+
+def stop_cleanly(proc):
+    """SIGINT must end the node with exit code 0 within a second."""
+    code, seconds = proc.stop()
+    assert code == 0, proc.output()
+    assert seconds < 1.0
+    assert 'Traceback' not in proc.output()
+
+
+def latest_status(probe, suffix):
+    """Key -> value of the newest diagnostic status whose name ends with ``suffix``."""
+    for array in reversed(probe.messages['/diagnostics']):
+        for st in array.status:
+            if st.name.endswith(suffix):
+                return st, status_values(st)
+    return None, {}
+
+
+def test_torque_free_motion_is_exact_and_bad_input_changes_nothing(launch, probe):
+    """Default integrator, 10 s simulated; NaN / inf / unknown-frame torques and bad parameters."""
+    proc = launch(SIM, '-p', 'publish_clock:=true', '-p', 'real_time_factor:=2.0', name='sim')
+    odom = probe.subscribe(Odometry, 'odom')
+    l_world = probe.subscribe(Vector3Stamped, 'angular_momentum')
+    inertia = probe.subscribe(InertiaStamped, 'inertia', LATCHED)
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    probe.wait_for('inertia')
+    assert inertia[0].header.frame_id == 'base_link'
+    assert (inertia[0].inertia.ixx, inertia[0].inertia.iyy, inertia[0].inertia.izz) == \
+        (1.0, 1.0, 1.5)
+    probe.wait_for('odom', 5)
+
+    torque = probe.publisher(WrenchStamped, 'torque_cmd')
+    for vec, frame in (((math.nan, 0.0, 0.0), ''), ((0.0, math.inf, 0.0), 'base_link'),
+                       ((0.0, 0.0, -math.inf), 'odom'), ((1.0, 0.0, 0.0), 'map'),
+                       ((1.0, 0.0, 0.0), 'x' * 10000)):
+        msg = WrenchStamped()
+        msg.header.frame_id = frame
+        msg.wrench.torque.x, msg.wrench.torque.y, msg.wrench.torque.z = vec
+        torque.publish(msg)
+    refusals = {
+        'inertia': ([1.0, 1.0, 5.0], 'triangle'),
+        'initial_angular_velocity': ([1.0, math.nan, 0.0], 'finite'),
+        'publish_rate': (5000.0, 'publish_rate'),
+        'integrator': ('euler', 'unknown integrator'),
+        'real_time_factor': (-1.0, ''),
+    }
+    for name, (value, reason) in refusals.items():
+        result = set_params(probe, **{name: value})[0]
+        assert not result.successful, name
+        assert reason in result.reason, result.reason
+    assert not set_params(probe, inertia=[-1.0, 2.0, 2.0])[0].successful
+    assert 'read-only' in set_params(probe, integration_rate=10.0)[0].reason
+
+    probe.spin_until(lambda: odom and stamp(odom[-1]) >= 10.0, 30.0, '10 s of simulated time')
+    assert len(odom) > 200
+    # the published state is the exact solution as if nothing bad had come
+    assert_exact(odom, (1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    t, q, w = odom_arrays(odom)
+    energy = 0.5 * np.sum(np.array([1.0, 1.0, 1.5]) * w * w, axis=1)
+    assert np.max(np.abs(energy / energy[0] - 1.0)) <= 1e-10
+    _, lw = vectors(l_world)
+    assert np.max(np.abs(np.linalg.norm(lw, axis=1) / np.linalg.norm(lw[0]) - 1.0)) <= 1e-10
+    angles = np.arctan2(np.linalg.norm(np.cross(lw, lw[0]), axis=1), lw @ lw[0])
+    assert np.max(angles) <= 1e-10
+    probe.spin_until(lambda: latest_status(probe, 'torque command')[1].get(
+        'rejected_frame') == '2', 10.0, 'rejections counted in diagnostics')
+    status, values = latest_status(probe, 'torque command')
+    assert values['rejected_non_finite'] == '3'
+    assert values['accepted'] == '0'
+    assert 'rejected' in status.message
+    stop_cleanly(proc)
+
+
+def _torque_on_time(applied):
+    """Stamp at which the first non-zero applied torque began (start of its step)."""
+    first = next(m for m in applied if any(vector_array(m.wrench.torque)))
+    return first, stamp(first)
+
+
+def test_constant_body_torque_about_the_symmetry_axis(launch, probe):
+    """omega3(t) = omega3(t_on) + tau (t - t_on) / I3 for a top spinning about its axis."""
+    tau, i3 = 0.3, 1.5
+    proc = launch(SIM, '-p', 'publish_clock:=true', '-p', 'initial_angular_velocity:=[0,0,2]',
+                  '-p', 'torque_timeout:=0.0', '-p', 'publish_rate:=1000.0', name='sim')
+    omega = probe.subscribe(Vector3Stamped, 'angular_velocity')
+    applied = probe.subscribe(WrenchStamped, 'applied_torque')
+    probe.wait_for('angular_velocity', 10)
+    cmd = WrenchStamped()
+    cmd.header.frame_id = 'base_link'
+    cmd.wrench.torque.z = tau
+    probe.publisher(WrenchStamped, 'torque_cmd').publish(cmd)
+    probe.spin_until(lambda: any(m.wrench.torque.z for m in applied), 10.0, 'applied torque')
+    first, t_end_of_first = _torque_on_time(applied)
+    assert vector_array(first.wrench.torque).tolist() == [0.0, 0.0, tau]
+    t_on = t_end_of_first - 1e-3           # the torque is held over the step ending there
+    probe.spin_until(lambda: stamp(omega[-1]) > t_on + 1.0, 20.0, '1 s under torque')
+    t, w = vectors(omega)
+    before = t < t_on - 1e-9
+    w3_on = w[before][-1, 2]
+    after = t > t_on
+    expected = w3_on + tau * (t[after] - t_on) / i3
+    np.testing.assert_allclose(w[after, 2], expected, rtol=1e-9)
+    assert np.max(np.abs(w[:, :2])) == 0.0
+    stop_cleanly(proc)
+
+
+def test_world_torque_changes_l_world_by_its_integral_then_times_out(launch, probe):
+    """L_w(t) - L_w(t_on) = tau_w (t - t_on); after the timeout the motion is free again."""
+    tau_w = np.array([0.05, -0.02, 0.04])
+    proc = launch(SIM, '-p', 'publish_clock:=true', '-p', 'preset:=tennis_racket',
+                  '-p', 'torque_timeout:=0.3', '-p', 'publish_rate:=1000.0', name='sim')
+    l_world = probe.subscribe(Vector3Stamped, 'angular_momentum')
+    applied = probe.subscribe(WrenchStamped, 'applied_torque')
+    odom = probe.subscribe(Odometry, 'odom')
+    probe.wait_for('angular_momentum', 10)
+    cmd = WrenchStamped()
+    cmd.header.frame_id = 'odom'
+    cmd.wrench.torque.x, cmd.wrench.torque.y, cmd.wrench.torque.z = tau_w
+    cmd.wrench.force.x = 1.0                           # ignored, with a warning
+    probe.publisher(WrenchStamped, 'torque_cmd').publish(cmd)
+    probe.spin_until(lambda: any(any(vector_array(m.wrench.torque)) for m in applied), 10.0,
+                     'applied torque')
+    _, t_first = _torque_on_time(applied)
+    t_on = t_first - 1e-3
+    # wait for the timeout (0.3 s of steady time at real time) and 1 s of free motion
+    probe.spin_until(lambda: stamp(applied[-1]) > t_on + 1.5, 20.0, 'the timeout')
+    torques = np.array([vector_array(m.wrench.torque) for m in applied])
+    t_applied = np.array([stamp(m) for m in applied])
+    on = np.any(torques != 0.0, axis=1)
+    t_off = t_applied[on][-1]                          # last step under torque ends here
+    assert 0.2 < t_off - t_on < 0.5                    # about the 0.3 s timeout
+    assert not np.any(on[t_applied > t_off])           # zero after the timeout
+    t, lw = vectors(l_world)
+    l_on = lw[np.argmin(np.abs(t - t_on))]
+    during = (t > t_on) & (t <= t_off)
+    expected = l_on + np.outer(t[during] - t_on, tau_w)
+    np.testing.assert_allclose(lw[during], expected, rtol=0, atol=1e-9 * np.linalg.norm(l_on))
+    after = t > t_off
+    np.testing.assert_allclose(lw[after], lw[after][0] + 0.0 * lw[after], atol=1e-12)
+    # the free motion after the timeout is exact from the state at t_off
+    to, qo, wo = odom_arrays(odom)
+    k = np.argmin(np.abs(to - t_off))
+    free = FreeRigidBody((1.0, 2.0, 3.0), wo[k], qo[k])
+    later = to > t_off
+    q_ref, w_ref = free.state_at(to[later] - to[k])
+    assert np.max(quaternions.angle_between(qo[later], q_ref)) < 1e-9
+    assert 'only the torque is used' in proc.output()
+    stop_cleanly(proc)
+
+
+def test_reset_and_pause(launch, probe):
+    proc = launch(SIM, '-p', 'publish_clock:=true', name='sim')
+    odom = probe.subscribe(Odometry, 'odom')
+    probe.spin_until(lambda: odom and stamp(odom[-1]) > 0.5, 20.0, '0.5 s of motion')
+    paused = probe.call(SetBool, f'{NODE}/pause', SetBool.Request(data=True))
+    assert paused.success and paused.message == 'paused'
+    probe.spin_for(0.3)
+    count = len(odom)
+    t_paused = stamp(odom[-1])
+    probe.spin_for(0.5)
+    assert len(odom) == count                          # frozen: nothing new published
+    probe.call(SetBool, f'{NODE}/pause', SetBool.Request(data=False))
+    probe.spin_until(lambda: stamp(odom[-1]) > t_paused + 0.2, 10.0, 'motion after resume')
+    t = np.array([stamp(m) for m in odom])
+    assert np.all(np.diff(t) > 0.0)                    # resumed where it stopped
+    assert_exact(odom, (1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    result = probe.call(Trigger, f'{NODE}/reset', Trigger.Request())
+    assert result.success
+    n_before = len(odom)
+    probe.spin_until(lambda: len(odom) > n_before + 5, 10.0, 'motion after reset')
+    t_after = np.array([stamp(m) for m in odom[n_before:]])
+    assert t_after[0] < 0.1                            # time restarted at 0
+    assert_exact(odom[n_before:], (1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    stop_cleanly(proc)
+
+
+def test_two_namespaces_remapping_and_clock(launch, probe):
+    a = launch(SIM, '-r', '__ns:=/sat_a', '-p', 'publish_clock:=true',
+               '-r', 'odom:=truth', name='sat_a')
+    b = launch(SIM, '-r', '__ns:=/sat_b', '-p', 'preset:=tennis_racket', name='sat_b')
+    truth_a = probe.subscribe(Odometry, '/sat_a/truth')
+    odom_b = probe.subscribe(Odometry, '/sat_b/odom')
+    inertia_a = probe.subscribe(InertiaStamped, '/sat_a/inertia', LATCHED)
+    inertia_b = probe.subscribe(InertiaStamped, '/sat_b/inertia', LATCHED)
+    clock = probe.subscribe(Clock, '/clock', qos_profile_sensor_data)
+    probe.wait_for('/sat_a/truth', 20)
+    probe.wait_for('/sat_b/odom', 20)
+    probe.wait_for('/clock', 20)
+    assert inertia_a[0].inertia.izz == 1.5 and inertia_b[0].inertia.izz == 3.0
+    assert_exact(truth_a, (1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    t_b, _, w_b = odom_arrays(odom_b)
+    _, w_ref = FreeRigidBody((1.0, 2.0, 3.0), (0.01, 2.0, 0.01)).state_at(t_b - t_b[0])
+    assert abs(w_b[0][1] - 2.0) < 0.1                  # b is the racket, not the top
+    clock_t = [c.clock.sec + 1e-9 * c.clock.nanosec for c in clock]
+    assert clock_t[-1] > clock_t[0] and np.all(np.diff(clock_t) > 0.0)
+    stop_cleanly(a)
+    stop_cleanly(b)
+
+
+def test_unknown_preset_and_bad_inertia_refuse_to_start(launch):
+    proc = launch(SIM, '-p', 'preset:=hoop', name='bad_preset')
+    assert proc.wait(20.0) == 1
+    assert "unknown preset 'hoop'" in proc.output()
+    proc = launch(SIM, '-p', 'inertia:=[1.0, 1.0, 3.0]', name='bad_inertia')
+    assert proc.wait(20.0) == 1
+    assert 'triangle inequality' in proc.output()
+
+
+def test_rotated_tensor_publishes_in_the_users_body_frame(launch, probe):
+    rot = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])   # 90 deg about z
+    tensor = rot @ np.diag([1.0, 2.0, 3.0]) @ rot.T
+    six = [tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2]]
+    w_user = rot @ np.array([0.3, 0.5, 2.0])
+    proc = launch(SIM, '-p', 'publish_clock:=true', '-p', 'real_time_factor:=5.0',
+                  '-p', 'inertia_tensor:=[' + ','.join(f'{v:.1f}' for v in six) + ']',
+                  '-p', 'initial_angular_velocity:=[' + ','.join(repr(float(v)) for v in w_user)
+                  + ']', name='sim')
+    odom = probe.subscribe(Odometry, 'odom')
+    probe.spin_until(lambda: odom and stamp(odom[-1]) > 2.0, 20.0, '2 s of motion')
+    assert_exact(odom, Inertia.from_tensor(tensor), tuple(w_user))
+    stop_cleanly(proc)
+
+
+@pytest.mark.parametrize('signal_name', ['SIGTERM'])
+def test_sigterm_exits_zero(launch, probe, signal_name):
+    import signal
+    proc = launch(SIM, name='sim')
+    probe.subscribe(Odometry, 'odom')
+    probe.wait_for('odom', 3)
+    proc.proc.send_signal(getattr(signal, signal_name))
+    assert proc.wait(5.0) == 0
+    assert 'Traceback' not in proc.output()
