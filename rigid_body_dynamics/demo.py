@@ -1,13 +1,20 @@
 """
-Offline physics demo: theory against simulation for a preset body, no ROS.
+The main job: run the simulator node, watch its topics, print what the motion does.
 
-``rigid_body_demo [--preset NAME] [--integrator NAME] [--duration S]``
-simulates the body, measures what the motion does with the estimators, and
-prints it beside the closed-form predictions.
+``rigid_body_demo`` starts ``attitude_simulator`` as its own process on the
+default body (DDS kept on this machine, a free domain id if none is set),
+records its state topics for a stretch of simulated time, measures the
+precession rates and conservation from them, prints that beside theory, and
+stops the node with Ctrl-C's signal. ``--offline`` does the same without ROS,
+straight from the physics layer.
 """
 
 import argparse
+import os
+import signal
+import subprocess
 import sys
+import time
 
 import numpy as np
 
@@ -19,14 +26,15 @@ def _line(label, measured, predicted, unit):
     return f'  {label:<34} {measured:>+.10f} {unit:<6} theory {predicted:>+.10f}  (rel. {rel:.1e})'
 
 
-def report(preset, integrator, duration, dt):
-    """Simulate ``preset`` and return the lines of the comparison."""
+def report(preset, integrator, duration, dt, run=None):
+    """Compare a run of ``preset`` (simulated here unless given) with theory; returns lines."""
     body = presets.get(preset)
     moments = np.array(body.moments)
-    run = simulate(moments, body.omega0, body.q0, duration, dt, integrator=integrator)
+    if run is None:
+        run = simulate(moments, body.omega0, body.q0, duration, dt, integrator=integrator)
     lines = [f'{body.name}: {body.description}',
              f'  I = {body.moments} kg m^2, omega0 = {body.omega0} rad/s body, '
-             f'{integrator}, dt = {dt} s, {duration} s']
+             f'{integrator}, dt = {dt} s, {run.t[-1] - run.t[0]:.4g} s of samples']
     shape_axis = FreeRigidBody(moments, body.omega0).shape.axis
     if shape_axis is not None:
         ax = shape_axis
@@ -57,23 +65,112 @@ def report(preset, integrator, duration, dt):
     return lines
 
 
+class Recording:
+    """Samples recorded from the topics: the same fields simulate() returns."""
+
+    def __init__(self, t, q, omega):
+        self.t, self.q, self.omega = t, q, omega
+
+
+def record_from_node(preset, integrator, duration, rate):
+    """
+    Start attitude_simulator, record ``duration`` s of simulated time from odom, stop it.
+
+    Runs at real-time factor 4 with stamps = simulated time (publish_clock).
+    Returns a Recording whose t starts at 0.
+    """
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from nav_msgs.msg import Odometry
+
+    from .nodes.conversions import quaternion_array, vector_array
+    rtf = 4.0
+    cmd = [sys.executable, '-m', 'rigid_body_dynamics.nodes.simulator', '--ros-args',
+           '-p', f'preset:={preset}', '-p', f'integrator:={integrator}',
+           '-p', f'integration_rate:={rate}', '-p', f'real_time_factor:={rtf}',
+           '-p', 'publish_clock:=true', '--log-level', 'warn']
+    node_proc = subprocess.Popen(cmd)
+    ctx = Context()
+    rclpy.init(context=ctx)
+    node = rclpy.create_node('rigid_body_demo', context=ctx)
+    executor = SingleThreadedExecutor(context=ctx)
+    executor.add_node(node)
+    samples = []
+    node.create_subscription(Odometry, 'odom', samples.append,
+                             QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE))
+    print(f'started attitude_simulator (pid {node_proc.pid}, preset {preset}, {integrator}); '
+          f'recording {duration:g} s of simulated time at {rtf:g}x real time ...', flush=True)
+    deadline = time.monotonic() + 30.0 + duration / rtf
+
+    def sim_time():
+        h = samples[-1].header.stamp
+        return h.sec + 1e-9 * h.nanosec
+    try:
+        while (not samples or sim_time() < duration) and time.monotonic() < deadline:
+            if node_proc.poll() is not None:
+                raise RuntimeError(f'attitude_simulator exited with code {node_proc.returncode}')
+            executor.spin_once(timeout_sec=0.05)
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.shutdown(context=ctx)
+        if node_proc.poll() is None:
+            node_proc.send_signal(signal.SIGINT)
+            try:
+                node_proc.wait(10.0)
+            except subprocess.TimeoutExpired:
+                node_proc.kill()
+    if not samples or sim_time() < duration:
+        raise RuntimeError('no state arrived from attitude_simulator in time')
+    print(f'stopped attitude_simulator (exit code {node_proc.returncode}); '
+          f'{len(samples)} odom messages', flush=True)
+    t = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for m in samples])
+    q = np.array([quaternion_array(m.pose.pose.orientation) for m in samples])
+    w = np.array([vector_array(m.twist.twist.angular) for m in samples])
+    return Recording(t, q, w)
+
+
+def _ros_environment():
+    """Keep DDS on this machine and pick a free domain unless the user chose one."""
+    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    os.environ.pop('ROS_LOCALHOST_ONLY', None)
+    if 'ROS_DOMAIN_ID' in os.environ:
+        return None
+    from domain_coordinator import domain_id
+    reservation = domain_id()
+    os.environ['ROS_DOMAIN_ID'] = str(reservation.__enter__())
+    return reservation
+
+
 def main(argv=None):
-    """Console entry point: print theory against simulation."""
+    """Console entry point: print theory against simulation (nodes, or --offline)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--preset', default=None, help='preset name (default: a tour of several)')
     parser.add_argument('--integrator', default='exact', choices=sorted(INTEGRATORS))
     parser.add_argument('--duration', type=float, default=None, help='simulated seconds')
     parser.add_argument('--dt', type=float, default=1e-3, help='step (s)')
+    parser.add_argument('--offline', action='store_true', help='physics only, no ROS nodes')
     args = parser.parse_args(argv)
     names = [args.preset] if args.preset else ['symmetric_top', 'tennis_racket']
+    reservation = None if args.offline else _ros_environment()
     try:
         for name in names:
             body = presets.get(name)
-            print('\n'.join(report(name, args.integrator, args.duration or body.duration,
-                                   args.dt)))
-    except ValueError as err:
+            duration = args.duration or body.duration
+            run = None
+            if not args.offline:
+                run = record_from_node(name, args.integrator, duration, 1.0 / args.dt)
+            print('\n'.join(report(name, args.integrator, duration, args.dt, run)), flush=True)
+    except (ValueError, RuntimeError) as err:
         print(f'rigid_body_demo: {err}', file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        return 130
+    finally:
+        if reservation is not None:
+            reservation.__exit__(None, None, None)
     return 0
 
 
