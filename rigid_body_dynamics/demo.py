@@ -76,8 +76,8 @@ def record_from_node(preset, integrator, duration, rate):
     """
     Start attitude_simulator, record ``duration`` s of simulated time from odom, stop it.
 
-    Runs at real-time factor 4 with stamps = simulated time (publish_clock).
-    Returns a Recording whose t starts at 0.
+    Runs at real-time factor 4 with stamps = simulated time (publish_clock),
+    recording from the first message that arrives (after DDS discovery).
     """
     import rclpy
     from rclpy.context import Context
@@ -107,8 +107,11 @@ def record_from_node(preset, integrator, duration, rate):
     def sim_time():
         h = samples[-1].header.stamp
         return h.sec + 1e-9 * h.nanosec
+    def recorded():
+        first = samples[0].header.stamp
+        return sim_time() - (first.sec + 1e-9 * first.nanosec)
     try:
-        while (not samples or sim_time() < duration) and time.monotonic() < deadline:
+        while (not samples or recorded() < duration) and time.monotonic() < deadline:
             if node_proc.poll() is not None:
                 raise RuntimeError(f'attitude_simulator exited with code {node_proc.returncode}')
             executor.spin_once(timeout_sec=0.05)
@@ -122,7 +125,7 @@ def record_from_node(preset, integrator, duration, rate):
                 node_proc.wait(10.0)
             except subprocess.TimeoutExpired:
                 node_proc.kill()
-    if not samples or sim_time() < duration:
+    if not samples or recorded() < duration:
         raise RuntimeError('no state arrived from attitude_simulator in time')
     print(f'stopped attitude_simulator (exit code {node_proc.returncode}); '
           f'{len(samples)} odom messages', flush=True)
