@@ -3,7 +3,9 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 
 ``./dev bench`` (full: 1e6 steps) or ``./dev bench --quick`` (1e5 steps);
 ``--peers`` adds MuJoCo and Basilisk if installed
-(``.venv/bin/pip install -r benchmarks/requirements-peers.txt``).
+(``.venv/bin/pip install -r benchmarks/requirements-peers.txt``);
+``--nodes`` measures the simulator node as a process (CPU, rates, latency);
+``--only nodes`` skips the physics sections.
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
 run now are replaced.
@@ -39,11 +41,39 @@ def main():
     parser = argparse.ArgumentParser(description='rigid_body_dynamics benchmarks')
     parser.add_argument('--quick', action='store_true', help='1e5 steps instead of 1e6')
     parser.add_argument('--peers', action='store_true', help='also MuJoCo and Basilisk')
+    parser.add_argument('--nodes', action='store_true', help='also the simulator node')
+    parser.add_argument('--only', choices=['nodes'], help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
     machine = common.machine()
     sections = {}
 
+    if args.only == 'nodes':
+        args.nodes = True
+    else:
+        physics_sections(sections, steps, machine, args.peers)
+    if args.nodes:
+        node_section(sections, machine, args.quick)
+    write(sections)
+
+
+def node_section(sections, machine, quick):
+    """Measure attitude_simulator as a process, in a DDS domain of its own on this machine."""
+    from domain_coordinator import domain_id
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    os.environ.pop('ROS_LOCALHOST_ONLY', None)
+    import nodes
+    print('nodes ...', flush=True)
+    with domain_id() as domain:
+        os.environ['ROS_DOMAIN_ID'] = str(domain)
+        lines = nodes.measure(quick)
+    header = ['## attitude_simulator as a process', '', f'Measured {machine}.', '',
+              nodes.__doc__.strip().replace('\n', ' '), '']
+    sections['nodes'] = '\n'.join(header + lines)
+
+
+def physics_sections(sections, steps, machine, with_peers):
+    """Accuracy, torque and (optionally) peer sections."""
     print(f'accuracy and cost, {steps} steps per integrator ...', flush=True)
     rows = accuracy.measure(steps)
     sections['physics-accuracy'] = '\n'.join([
@@ -78,7 +108,7 @@ def main():
                       '\\|L_w - L_w0 - H\\| (rel.)'], rows),
     ])
 
-    if args.peers:
+    if with_peers:
         print('peers ...', flush=True)
         rows = peers.measure()
         sections['peers'] = '\n'.join([
@@ -93,6 +123,9 @@ def main():
                           'ms per sim. s', 'cost / our rk4'], rows),
         ])
 
+
+def write(sections):
+    """Replace the measured sections in RESULTS.md and print it."""
     text = open(RESULTS).read() if os.path.exists(RESULTS) else (
         '# Benchmark results\n\nWritten by `./dev bench` (see benchmarks/run.py); '
         'each section records the machine and date it was measured on.\n')

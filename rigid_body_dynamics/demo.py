@@ -107,6 +107,7 @@ def record_from_node(preset, integrator, duration, rate):
     def sim_time():
         h = samples[-1].header.stamp
         return h.sec + 1e-9 * h.nanosec
+
     def recorded():
         first = samples[0].header.stamp
         return sim_time() - (first.sec + 1e-9 * first.nanosec)

@@ -1,0 +1,230 @@
+"""
+attitude_simulator as a process: CPU, sustainable rates, as-fast-as-possible speed, latency.
+
+Every measurement starts the node as its own process (as a user does) in a
+private DDS domain on this machine and reads its CPU time from /proc and its
+own diagnostics (achieved real-time factor, missed deadlines). Floors: the same
+measurements on minimal rclpy nodes (an idle node; a node with a 1 kHz steady
+timer and an empty callback; a relay that republishes torque_cmd at once).
+"""
+
+import os
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import WrenchStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rigid_body_dynamics.nodes.conversions import status_values
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, '..', 'test'))
+from ros_harness import Probe  # noqa: E402
+
+SIM = [sys.executable, '-m', 'rigid_body_dynamics.nodes.simulator', '--ros-args']
+FLOOR_TIMER = textwrap.dedent("""
+    import rclpy
+    from rclpy.clock import Clock, ClockType
+    rclpy.init()
+    node = rclpy.create_node('floor')
+    node.create_timer(0.001, lambda: None, clock=Clock(clock_type=ClockType.STEADY_TIME))
+    try:
+        rclpy.spin(node)
+    except BaseException:
+        pass
+""")
+FLOOR_IDLE = FLOOR_TIMER.replace(
+    'node.create_timer(0.001, lambda: None, clock=Clock(clock_type=ClockType.STEADY_TIME))', '')
+FLOOR_RELAY = textwrap.dedent("""
+    import rclpy
+    from geometry_msgs.msg import WrenchStamped
+    rclpy.init()
+    node = rclpy.create_node('relay')
+    pub = node.create_publisher(WrenchStamped, 'applied_torque', 10)
+    node.create_subscription(WrenchStamped, 'torque_cmd', pub.publish, 10)
+    try:
+        rclpy.spin(node)
+    except BaseException:
+        pass
+""")
+
+
+def cpu_seconds(pid):
+    """User + system CPU time (s) of a process, from /proc."""
+    with open(f'/proc/{pid}/stat') as f:
+        fields = f.read().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+class Process:
+    """A node process with its output in a temporary file; SIGINT on close."""
+
+    def __init__(self, cmd):
+        self.log = tempfile.TemporaryFile()
+        self.proc = subprocess.Popen(cmd, stdout=self.log, stderr=subprocess.STDOUT)
+
+    def close(self):
+        """Stop with SIGINT (kill after 10 s)."""
+        self.proc.send_signal(2)
+        try:
+            self.proc.wait(10.0)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+
+
+def script(source):
+    """Command running a Python source string."""
+    return [sys.executable, '-c', source]
+
+
+def measure_cpu(cmd, probe, warmup=3.0, window=8.0):
+    """
+    CPU fraction of one core over ``window`` s after ``warmup``, and the diagnostics seen.
+
+    Returns (cpu, values of the integrator status at the start and at the end
+    of the window, or None for processes without diagnostics).
+    """
+    diags = probe.messages.setdefault('/diagnostics', [])
+    diags.clear()
+    proc = Process(cmd)
+    try:
+        probe.spin_for(warmup)
+        first = len(diags)
+        c0, t0 = cpu_seconds(proc.proc.pid), time.monotonic()
+        probe.spin_for(window)
+        cpu = (cpu_seconds(proc.proc.pid) - c0) / (time.monotonic() - t0)
+        status = [status_values(s) for a in diags[max(first - 1, 0):] for s in a.status
+                  if s.name.endswith('integrator')]
+        return cpu, (status[0], status[-1]) if len(status) >= 2 else None
+    finally:
+        proc.close()
+
+
+def sustained(diag, rtf):
+    """Missed deadlines in the window and the achieved real-time factor at its end."""
+    start, end = diag
+    missed = int(end['missed deadlines']) - int(start['missed deadlines'])
+    achieved = float(end['achieved real-time factor'])
+    return missed, achieved, missed == 0 and achieved >= 0.99 * rtf
+
+
+def sim(*params):
+    """Build the simulator command with ``-p`` parameters."""
+    cmd = list(SIM)
+    for p in params:
+        cmd += ['-p', p]
+    return cmd
+
+
+def latency(cmd, probe, commands=100, period=0.05):
+    """Measure the time (s) from publishing torque_cmd to receiving applied_torque with it."""
+    arrivals = {}
+    probe.node.create_subscription(
+        WrenchStamped, 'applied_torque',
+        lambda m: arrivals.setdefault(round(m.wrench.torque.x * 1e6), time.monotonic()),
+        QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
+    proc = Process(cmd)
+    try:
+        pub = probe.publisher(WrenchStamped, 'torque_cmd')
+        probe.spin_for(2.0)
+        sent = {}
+        for k in range(1, commands + 1):
+            msg = WrenchStamped()
+            msg.wrench.torque.x = k * 1e-6
+            sent[k] = time.monotonic()
+            pub.publish(msg)
+            probe.spin_for(period)
+        probe.spin_for(0.5)
+    finally:
+        proc.close()
+    return np.array([arrivals[k] - sent[k] for k in sent if k in arrivals])
+
+
+def measure(quick=False):
+    """All node measurements; returns Markdown lines."""
+    probe = Probe('bench')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    window = 4.0 if quick else 8.0
+    lines = []
+    try:
+        cpu_exact, diag = measure_cpu(sim(), probe, window=window)
+        cpu_rk4, _ = measure_cpu(sim('integrator:=rk4'), probe, window=window)
+        cpu_idle, _ = measure_cpu(script(FLOOR_IDLE), probe, window=window)
+        cpu_timer, _ = measure_cpu(script(FLOOR_TIMER), probe, window=window)
+        lines += [
+            '### CPU at the defaults (1 kHz integration, 100 Hz publishing, real time)', '',
+            '| process | CPU (% of one core) | ratio to the 1 kHz timer floor |', '|---|---|---|',
+            f'| attitude_simulator, exact | {100 * cpu_exact:.1f} | {cpu_exact / cpu_timer:.2f} |',
+            f'| attitude_simulator, rk4 | {100 * cpu_rk4:.1f} | {cpu_rk4 / cpu_timer:.2f} |',
+            f'| floor: rclpy node, 1 kHz steady timer, empty callback | {100 * cpu_timer:.1f} '
+            '| 1.00 |',
+            f'| floor: idle rclpy node | {100 * cpu_idle:.1f} | {cpu_idle / cpu_timer:.2f} |',
+            '', 'The simulator paces its steps on a thread sleeping to each deadline, not on an '
+            'rclpy timer, which is why it costs less than the naive 1 kHz timer floor.', '']
+
+        lines += ['### Highest integration rate sustained in real time (100 Hz publishing)', '',
+                  '| integrator | rate (Hz) | missed deadlines | achieved real-time factor | '
+                  'sustained |', '|---|---|---|---|---|']
+        rates = (1000, 2000, 5000, 10000, 20000, 40000)
+        for name in ('exact', 'exact4', 'rk4', 'dop853'):
+            for rate in rates:
+                _, diag = measure_cpu(sim(f'integrator:={name}', f'integration_rate:={rate}.0'),
+                                      probe, warmup=2.0, window=window / 2)
+                missed, achieved, ok = sustained(diag, 1.0)
+                lines.append(f'| {name} | {rate} | {missed} | {achieved:.3f} | '
+                             f'{"yes" if ok else "no"} |')
+                if not ok:
+                    break
+        lines.append('')
+
+        lines += ['### Highest publish rate sustained in real time (every step published; '
+                  '6 state topics + imu)', '',
+                  '| publish rate (Hz) | missed deadlines | achieved real-time factor | '
+                  'odom received by a subscriber (Hz) | sustained |', '|---|---|---|---|---|']
+        odom = probe.subscribe(Odometry, 'odom',
+                               QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE))
+        for rate in (100, 1000, 2000, 5000):
+            odom.clear()
+            _, diag = measure_cpu(sim(f'integration_rate:={rate}.0', f'publish_rate:={rate}.0'),
+                                  probe, warmup=2.0, window=window / 2)
+            received = len(odom) / (2.0 + window / 2)
+            missed, achieved, ok = sustained(diag, 1.0)
+            lines.append(f'| {rate} | {missed} | {achieved:.3f} | {received:.0f} | '
+                         f'{"yes" if ok else "no"} |')
+            if not ok:
+                break
+        lines.append('')
+
+        lines += ['### As fast as possible (real_time_factor 0), 1 kHz integration', '',
+                  '| publishing | integrator | simulated s per wall s |', '|---|---|---|']
+        for label, pub in (('every 10 ms of simulated time', '100.0'), ('off', '0.000001')):
+            for name in ('exact', 'rk4'):
+                _, diag = measure_cpu(sim('real_time_factor:=0.0', f'publish_rate:={pub}',
+                                          f'integrator:={name}'), probe, warmup=2.0,
+                                      window=window / 2)
+                speed = float(diag[1]['achieved real-time factor'])
+                lines.append(f'| {label} | {name} | {speed:.1f} |')
+        lines.append('')
+
+        ours = latency(sim('publish_rate:=1000.0', 'torque_timeout:=0.0'), probe)
+        probe2 = Probe('bench_relay')
+        try:
+            floor = latency(script(FLOOR_RELAY), probe2)
+        finally:
+            probe2.close()
+        lines += ['### Latency from torque_cmd to the first applied_torque carrying it', '',
+                  'Both measured by one process that publishes the command and subscribes to '
+                  'the answer (1 kHz integration and publishing: one step is 1 ms).', '',
+                  '| path | samples | p50 (ms) | p99 (ms) | max (ms) |', '|---|---|---|---|---|']
+        for label, lat in (('attitude_simulator (command -> next step -> publish)', ours),
+                           ('floor: relay node republishing torque_cmd', floor)):
+            lines.append(f'| {label} | {lat.size} | {1e3 * np.percentile(lat, 50):.2f} | '
+                         f'{1e3 * np.percentile(lat, 99):.2f} | {1e3 * lat.max():.2f} |')
+    finally:
+        probe.close()
+    return lines
