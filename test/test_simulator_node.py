@@ -290,3 +290,15 @@ def test_sigterm_exits_zero(launch, probe, signal_name):
     proc.proc.send_signal(getattr(signal, signal_name))
     assert proc.wait(5.0) == 0
     assert 'Traceback' not in proc.output()
+
+
+def test_as_fast_as_possible_still_serves_services_and_diagnostics(launch, probe):
+    """real_time_factor 0 must not starve the executor: services, parameters, diagnostics."""
+    proc = launch(SIM, '-p', 'real_time_factor:=0.0', '-p', 'publish_rate:=1.0', name='sim')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    probe.wait_for('/diagnostics', 2, timeout=20.0)
+    _, values = latest_status(probe, 'integrator')
+    assert float(values['achieved real-time factor']) > 5.0
+    assert probe.call(Trigger, f'{NODE}/reset', Trigger.Request(), timeout=10.0).success
+    assert set_params(probe, max_torque=2.0)[0].successful
+    stop_cleanly(proc)
