@@ -471,7 +471,7 @@ class AttitudeSimulator(Node):
 
     # ------------------------------------------------------------------ publishing
     def _snapshot(self):
-        """What one publish tick needs, taken under the lock."""
+        """Take what one publish tick needs (under the lock)."""
         s = self._stepper
         return (self._steps, s.q, s.omega, self._last_torque, self._inertia)
 
