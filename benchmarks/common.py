@@ -3,7 +3,6 @@
 import datetime
 import os
 import platform
-import sys
 
 import numpy as np
 from rigid_body_dynamics.physics import equations, FreeRigidBody, quaternions
@@ -60,8 +59,3 @@ def table(header, rows):
     out = ['| ' + ' | '.join(header) + ' |', '|' + '---|' * len(header)]
     out += ['| ' + ' | '.join(str(c) for c in row) + ' |' for row in rows]
     return '\n'.join(out)
-
-
-def python_tag():
-    """Return the interpreter version, for the record."""
-    return sys.version.split()[0]

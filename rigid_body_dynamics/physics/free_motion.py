@@ -161,13 +161,6 @@ class PolhodeParameters:
         parity = 1.0 - 2.0 * (j % 2.0)
         return value, sn * parity, cn * parity, dn
 
-    def angle_integral_at_amplitude(self, phi):
-        """J~ at amplitude phi (rad, a float) without evaluating ellipj."""
-        j = round(phi / math.pi)
-        r = phi - j * math.pi
-        sn = math.sin(r)
-        return self._j_tilde(_Math, sn, math.cos(r), 1.0 - self.k2 * sn * sn, r, j)
-
     @property
     def psi_per_period(self):
         """Rotation angle about L (rad) accumulated by the attitude over one period of omega."""

@@ -125,15 +125,9 @@ def axis_stability(moments, axis, spin):
     return AxisStability(axis, 'stable' if product > 0.0 else 'unstable', rate)
 
 
-def nearest_axis(moments, omega):
-    """Index of the principal axis closest in direction to omega (body frame)."""
-    del moments
-    return int(np.argmax(np.abs(np.asarray(omega, dtype=float))))
-
-
 def stability(moments, omega):
-    """Apply :func:`axis_stability` to the principal axis nearest omega."""
-    axis = nearest_axis(moments, omega)
+    """Apply :func:`axis_stability` to the principal axis nearest omega (body frame)."""
+    axis = int(np.argmax(np.abs(np.asarray(omega, dtype=float))))
     return axis_stability(moments, axis, float(omega[axis]))
 
 
