@@ -105,13 +105,19 @@ def measure_cpu(cmd, probe, warmup=3.0, window=8.0):
         proc.close()
 
 
+#: A rate counts as sustained when the achieved real-time factor is at least 0.99 of
+#: the requested one and at most this many steps in the window were > 5 ms late
+#: (single scheduler hiccups of the machine, not the node, cause those).
+MAX_MISSED = 2
+
+
 def sustained(diag, rtf):
     """Missed deadlines in the window and the achieved real-time factor at its end."""
     start, end = diag
     key = next(k for k in end if k.startswith('missed deadlines'))
     missed = int(end[key]) - int(start[key])
     achieved = float(end['achieved real-time factor'])
-    return missed, achieved, missed == 0 and achieved >= 0.99 * rtf
+    return missed, achieved, missed <= MAX_MISSED and achieved >= 0.99 * rtf
 
 
 def sim(*params):
@@ -169,17 +175,22 @@ def measure(quick=False):
             'rclpy timer, which is why it costs less than the naive 1 kHz timer floor.', '']
 
         lines += ['### Highest integration rate sustained in real time (100 Hz publishing)', '',
+                  f'Sustained: achieved real-time factor >= 0.99 and at most {MAX_MISSED} '
+                  'steps more than 5 ms late in the window; the sweep ends after two '
+                  'failures in a row.', '',
                   '| integrator | rate (Hz) | missed deadlines | achieved real-time factor | '
                   'sustained |', '|---|---|---|---|---|']
         rates = (1000, 2000, 5000, 10000, 20000, 40000)
         for name in ('exact', 'exact4', 'rk4', 'dop853'):
+            failures = 0
             for rate in rates:
                 _, diag = measure_cpu(sim(f'integrator:={name}', f'integration_rate:={rate}.0'),
                                       probe, warmup=2.0, window=window / 2)
                 missed, achieved, ok = sustained(diag, 1.0)
                 lines.append(f'| {name} | {rate} | {missed} | {achieved:.3f} | '
                              f'{"yes" if ok else "no"} |')
-                if not ok:
+                failures = 0 if ok else failures + 1
+                if failures == 2:
                     break
         lines.append('')
 
@@ -189,6 +200,7 @@ def measure(quick=False):
                   'odom received by a subscriber (Hz) | sustained |', '|---|---|---|---|---|']
         odom = probe.subscribe(Odometry, 'odom',
                                QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE))
+        failures = 0
         for rate in (100, 1000, 2000, 5000):
             odom.clear()
             _, diag = measure_cpu(sim(f'integration_rate:={rate}.0', f'publish_rate:={rate}.0'),
@@ -197,7 +209,8 @@ def measure(quick=False):
             missed, achieved, ok = sustained(diag, 1.0)
             lines.append(f'| {rate} | {missed} | {achieved:.3f} | {received:.0f} | '
                          f'{"yes" if ok else "no"} |')
-            if not ok:
+            failures = 0 if ok else failures + 1
+            if failures == 2:
                 break
         lines.append('')
 

@@ -202,3 +202,37 @@ def growth_rate(t, amplitude):
     """Exponential growth rate (1/s): least-squares slope of log|amplitude| against t."""
     t, a = sort_samples(t, amplitude)
     return float(np.polyfit(t - t.mean(), np.log(np.abs(a)), 1)[0])
+
+
+def separatrix_growth_rate(t, omega, axis, fraction=0.1):
+    """
+    Growth rate (1/s) of departures from a spin about the intermediate ``axis``.
+
+    The perpendicular part p = |omega_perp| grows as exp(rate t) while it is
+    small; every rising run with p below ``fraction`` |omega| is fitted in
+    log p and the median of the runs' slopes returned. Raises ValueError when
+    no such run has at least 5 samples.
+    """
+    t, w = sort_samples(t, omega)
+    a, b = _perp_axes(axis)
+    p = np.hypot(w[:, a], w[:, b])
+    small = p < fraction * np.linalg.norm(w, axis=1)
+    rising = np.zeros_like(small)
+    rising[1:] = np.diff(p) > 0.0
+    keep = small & rising
+    slopes = []
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], keep.astype(int), [0]])))
+    for start, stop in zip(edges[::2], edges[1::2]):
+        if stop - start >= 5:
+            slopes.append(np.polyfit(t[start:stop], np.log(p[start:stop]), 1)[0])
+    if not slopes:
+        raise ValueError('no growing departure from the intermediate axis in the window')
+    return float(np.median(slopes))
+
+
+def flip_interval(t, omega, axis):
+    """Mean time (s) between sign changes of omega about the intermediate ``axis``."""
+    times = crossing_times(t, np.asarray(omega, dtype=float)[:, axis], direction=0)
+    if times.size < 2:
+        raise ValueError('fewer than two flips in the window')
+    return float(np.diff(times).mean())
