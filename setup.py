@@ -27,6 +27,7 @@ setup(
         'console_scripts': [
             'rigid_body_demo = rigid_body_dynamics.demo:main',
             'attitude_simulator = rigid_body_dynamics.nodes.simulator:main',
+            'attitude_analyzer = rigid_body_dynamics.nodes.analyzer:main',
         ],
     },
 )

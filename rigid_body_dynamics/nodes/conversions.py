@@ -60,10 +60,12 @@ def status(name, level, message, values, hardware_id='none'):
     items = values.items() if hasattr(values, 'items') else values
     out = []
     for key, value in items:
-        if isinstance(value, float):
-            text = repr(value)
-        elif isinstance(value, bool):
+        if isinstance(value, (bool, np.bool_)):
             text = 'true' if value else 'false'
+        elif isinstance(value, (float, np.floating)):
+            text = repr(float(value))
+        elif isinstance(value, np.integer):
+            text = str(int(value))
         else:
             text = str(value)
         out.append(KeyValue(key=str(key), value=text))

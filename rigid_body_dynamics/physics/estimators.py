@@ -204,29 +204,37 @@ def growth_rate(t, amplitude):
     return float(np.polyfit(t - t.mean(), np.log(np.abs(a)), 1)[0])
 
 
-def separatrix_growth_rate(t, omega, axis, fraction=0.1):
+def separatrix_growth_rate(t, omega, moments, fraction=0.1):
     """
-    Growth rate (1/s) of departures from a spin about the intermediate ``axis``.
+    Growth rate (1/s) of departures from a spin about the intermediate axis.
 
-    The perpendicular part p = |omega_perp| grows as exp(rate t) while it is
-    small; every rising run with p below ``fraction`` |omega| is fitted in
-    log p and the median of the runs' slopes returned. Raises ValueError when
-    no such run has at least 5 samples.
+    Near the saddle the perpendicular components (eps_1, eps_3) about the
+    min- and max-moment axes obey eps_1' = -W a eps_3, eps_3' = -W b eps_1
+    with a = (I3 - I2)/I1, b = (I2 - I1)/I3 (linearised (4.26)). The mode
+    coordinates u = eps_3 -/+ sqrt(b/a) eps_1 grow and decay as exp(+/-lambda t)
+    exactly; |eps| itself does not (the modes are not orthogonal, so it rises
+    up to 15 % faster for a while). Each passage with |eps| < ``fraction``
+    |omega| is fitted in log|u| for both signs; the larger slope is the
+    growth rate, and the median over passages is returned. ``moments`` are
+    the principal moments in body-axis order (kg m^2). ValueError when no
+    passage has at least 5 samples.
     """
     t, w = sort_samples(t, omega)
-    a, b = _perp_axes(axis)
-    p = np.hypot(w[:, a], w[:, b])
-    small = p < fraction * np.linalg.norm(w, axis=1)
-    rising = np.zeros_like(small)
-    rising[1:] = np.diff(p) > 0.0
-    keep = small & rising
+    order = np.argsort(np.asarray(moments, dtype=float))
+    i1, i2, i3 = (float(moments[k]) for k in order)
+    e1, e3 = w[:, order[0]], w[:, order[2]]
+    c = math.sqrt((i2 - i1) / i3 / ((i3 - i2) / i1))
+    near = np.hypot(e1, e3) < fraction * np.linalg.norm(w, axis=1)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], near.astype(int), [0]])))
     slopes = []
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], keep.astype(int), [0]])))
     for start, stop in zip(edges[::2], edges[1::2]):
-        if stop - start >= 5:
-            slopes.append(np.polyfit(t[start:stop], np.log(p[start:stop]), 1)[0])
+        if stop - start < 5:
+            continue
+        ts, a1, a3 = t[start:stop], e1[start:stop], e3[start:stop]
+        slopes.append(max(np.polyfit(ts, np.log(np.abs(a3 + sign * c * a1)), 1)[0]
+                          for sign in (1.0, -1.0)))
     if not slopes:
-        raise ValueError('no growing departure from the intermediate axis in the window')
+        raise ValueError('no passage near the intermediate axis in the window')
     return float(np.median(slopes))
 
 

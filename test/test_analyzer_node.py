@@ -1,0 +1,244 @@
+"""
+attitude_analyzer over real topics, against the simulator and against test publishers.
+
+Both nodes run as separate processes; the test reads the analyzer's
+/diagnostics and its Float64 topics. Every wait has a deadline.
+"""
+
+import math
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import WrenchStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+import pytest
+from rigid_body_dynamics.nodes.conversions import quaternion_msg, status_values, time_msg
+from rigid_body_dynamics.nodes.conversions import vector_msg
+from rigid_body_dynamics.physics import FreeRigidBody, presets, theory
+from std_msgs.msg import Float64
+from std_srvs.srv import Trigger
+
+SIM = 'rigid_body_dynamics.nodes.simulator'
+ANALYZER = 'rigid_body_dynamics.nodes.analyzer'
+
+
+def newest(probe, check):
+    """(level, message, values) of the analyzer's newest status ``check``, or None."""
+    for array in reversed(probe.messages['/diagnostics']):
+        for st in array.status:
+            if st.name == f'attitude_analyzer: {check}':
+                return st.level, st.message, status_values(st)
+    return None
+
+
+def wait_status(probe, check, predicate, timeout, what):
+    """Spin until the newest status ``check`` satisfies ``predicate(values)``; return it."""
+    def ok():
+        found = newest(probe, check)
+        return found is not None and predicate(found[2])
+    probe.spin_until(ok, timeout, what)
+    return newest(probe, check)
+
+
+def is_number(text):
+    """Tell whether a diagnostic value is a number (not 'not available: ...')."""
+    try:
+        float(text)
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+def stop_cleanly(*procs):
+    """SIGINT ends every node with exit code 0."""
+    for proc in procs:
+        code, _ = proc.stop()
+        assert code == 0, proc.output()
+        assert 'Traceback' not in proc.output()
+
+
+def test_symmetric_top_precession_and_conservation(launch, probe):
+    """Default body: body and lab precession within 1e-4 of theory; conservation OK."""
+    sim = launch(SIM, '-p', 'publish_clock:=true', '-p', 'real_time_factor:=4.0', name='sim')
+    analyzer = launch(ANALYZER, name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    body_rate = probe.subscribe(Float64, 'precession/body_rate')
+    energy = probe.subscribe(Float64, 'kinetic_energy')
+    level, message, values = wait_status(
+        probe, 'precession', lambda v: 'body rate error (rel.)' in v, 40.0,
+        'a precession estimate')
+    # let the window fill with a few precession periods (10 s of stamps)
+    probe.spin_for(3.0)
+    level, message, values = newest(probe, 'precession')
+    assert float(values['body rate error (rel.)']) < 1e-4
+    assert float(values['lab rate error (rel.)']) < 1e-4
+    assert float(values['body rate, theory (rad/s)']) == pytest.approx(1.0, rel=1e-12)
+    assert body_rate and body_rate[-1].data == pytest.approx(1.0, rel=1e-4)
+    assert energy[-1].data == pytest.approx(0.5 * (0.09 + 1.5 * 4.0), rel=1e-12)
+    level, message, values = newest(probe, 'conservation')
+    assert level == DiagnosticStatus.OK, message
+    assert float(values['energy drift since baseline (rel.)']) < 1e-12
+    level, message, values = newest(probe, 'stability')
+    assert values['class'] == 'stable' and values['nearest principal axis'] == '3'
+    level, message, values = newest(probe, 'input')
+    assert level == DiagnosticStatus.OK and float(values['rate (Hz)']) > 100.0
+    assert values['inertia source'] == 'topic'
+    stop_cleanly(analyzer, sim)
+
+
+def test_earth_wobble_period(launch, probe):
+    """The Chandler wobble of the earth preset at a million times real time: 300 days +- 0.5 %."""
+    sim = launch(SIM, '-p', 'preset:=earth_chandler', '-p', 'publish_clock:=true',
+                 '-p', 'publish_rate:=0.0002777777777777778', '-p', 'real_time_factor:=1.0e6',
+                 name='sim')
+    analyzer = launch(ANALYZER, '-p', 'window:=3.0e6', '-p', 'max_gap:=1.0e5',
+                      '-p', 'reset_jump:=1.0e5', name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    level, message, values = wait_status(
+        probe, 'precession', lambda v: 'body rate, measured (rad/s)' in v, 60.0,
+        'a wobble estimate')
+    period_days = 2.0 * math.pi / float(values['body rate, measured (rad/s)']) / \
+        theory.SIDEREAL_DAY
+    assert period_days == pytest.approx(300.0, rel=0.005)
+    stop_cleanly(analyzer, sim)
+
+
+def test_tennis_racket_is_unstable_with_measured_growth_and_flips(launch, probe):
+    body = presets.get('tennis_racket')
+    sim = launch(SIM, '-p', 'preset:=tennis_racket', '-p', 'publish_clock:=true',
+                 '-p', 'real_time_factor:=8.0', name='sim')
+    analyzer = launch(ANALYZER, '-p', 'window:=50.0', name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    level, message, values = wait_status(
+        probe, 'stability', lambda v: is_number(v.get('flip interval, measured (s)'))
+        and is_number(v.get('growth rate, measured (1/s)')), 60.0, 'measured flips')
+    assert values['class'] == 'unstable' and values['nearest principal axis'] == '2'
+    assert level == DiagnosticStatus.WARN
+    assert float(values['growth rate, measured (1/s)']) == pytest.approx(
+        theory.separatrix_growth_rate(body.moments, body.omega0), rel=0.02)
+    assert float(values['flip interval, measured (s)']) == pytest.approx(
+        theory.flip_interval(body.moments, body.omega0), rel=0.02)
+    stop_cleanly(analyzer, sim)
+
+
+def test_torque_pulses_keep_balance_laws_ok(launch, probe):
+    sim = launch(SIM, '-p', 'publish_clock:=true', '-p', 'torque_timeout:=0.3', name='sim')
+    analyzer = launch(ANALYZER, '-p', 'window:=3.0', name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    energy = probe.subscribe(Float64, 'kinetic_energy')
+    wait_status(probe, 'conservation', lambda v: v.get('mode') == 'free motion', 30.0,
+                'free-motion conservation')
+    e_before = energy[-1].data
+    torque = probe.publisher(WrenchStamped, 'torque_cmd')
+    for vec in ((0.3, 0.1, 0.5), (-0.2, 0.3, 0.4)):
+        msg = WrenchStamped()
+        msg.header.frame_id = 'base_link'
+        msg.wrench.torque = vector_msg(vec)
+        torque.publish(msg)
+        probe.spin_for(0.6)
+    level, message, values = wait_status(
+        probe, 'conservation', lambda v: v.get('mode', '').startswith('balance'), 10.0,
+        'balance-law mode')
+    assert level == DiagnosticStatus.OK, message
+    assert float(values['work-energy residual (rel.)']) < 1e-2
+    probe.spin_for(1.5)
+    assert abs(energy[-1].data / e_before - 1.0) > 0.01          # T really changed
+    levels = [st.level for a in probe.messages['/diagnostics'] for st in a.status
+              if st.name == 'attitude_analyzer: conservation']
+    assert max(levels) == DiagnosticStatus.OK
+    # torque gone from the window: back to free-motion drift checks, still OK
+    level, message, values = wait_status(
+        probe, 'conservation', lambda v: v.get('mode') == 'free motion', 15.0, 'free motion')
+    assert level == DiagnosticStatus.OK
+    stop_cleanly(analyzer, sim)
+
+
+def _publish_states(probe, pub, times, body, scale=None):
+    """Publish exact top states at ``times`` (s) as odom, optionally scaling omega by scale(t)."""
+    q, w = body.state_at(np.asarray(times))
+    for k, t in enumerate(times):
+        msg = Odometry()
+        msg.header.stamp = time_msg(int(round(t * 1e9)))
+        msg.header.frame_id, msg.child_frame_id = 'odom', 'base_link'
+        msg.pose.pose.orientation = quaternion_msg(q[k])
+        omega = w[k] * (scale(t) if scale else 1.0)
+        msg.twist.twist.angular = vector_msg(omega)
+        pub.publish(msg)
+        if k % 50 == 0:
+            probe.spin_for(0.005)
+
+
+def test_broken_physics_turns_conservation_to_error(launch, probe):
+    analyzer = launch(ANALYZER, '-p', 'inertia:=[1.0, 1.0, 1.5]', name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    pub = probe.publisher(Odometry, 'odom')
+    body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    # a "simulator" whose energy drifts by 2e-4 per second
+    _publish_states(probe, pub, np.arange(0.0, 4.0, 0.01), body, scale=lambda t: 1 + 1e-4 * t)
+    probe.spin_for(1.5)
+    _publish_states(probe, pub, np.arange(4.0, 8.0, 0.01), body, scale=lambda t: 1 + 1e-4 * t)
+    level, message, values = wait_status(
+        probe, 'conservation', lambda v: float(v.get('energy drift since baseline (rel.)', 0))
+        > 1e-4, 20.0, 'the drift to be seen')
+    assert level == DiagnosticStatus.ERROR, message
+    assert 'energy' in message
+    stop_cleanly(analyzer)
+
+
+def test_dropped_duplicated_reordered_and_time_reset(launch, probe, rng):
+    analyzer = launch(ANALYZER, '-p', 'inertia:=[1.0, 1.0, 1.5]', '-p', 'window:=5.0',
+                      name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    pub = probe.publisher(Odometry, 'odom')
+    body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+
+    def messy(t0, t1):
+        t = np.arange(t0, t1, 0.01)
+        t = t[rng.uniform(size=t.size) > 0.1]                       # 10 % dropped
+        t = np.concatenate([t, rng.choice(t, t.size // 20)])         # 5 % duplicated
+        t.sort()
+        blocks = [rng.permutation(t[i:i + 5]) for i in range(0, t.size, 5)]
+        return np.concatenate(blocks)                                # reordered locally
+
+    _publish_states(probe, pub, messy(0.0, 8.0), body)
+    level, message, values = wait_status(
+        probe, 'precession', lambda v: 'body rate error (rel.)' in v, 20.0, 'an estimate')
+    assert float(values['body rate error (rel.)']) < 1e-9
+    assert float(values['lab rate error (rel.)']) < 1e-9
+    # the source restarts: stamps go back to 0, with a different body state
+    body2 = FreeRigidBody((1.0, 1.0, 1.5), (0.5, 0.0, 1.0))
+    _publish_states(probe, pub, messy(0.0, 6.0), body2)
+    level, message, values = wait_status(
+        probe, 'input', lambda v: int(v.get('restarts after a time reset', 0)) >= 1, 20.0,
+        'the reset to be noticed')
+    probe.spin_for(1.5)
+    level, message, values = newest(probe, 'precession')
+    assert float(values['body rate, theory (rad/s)']) == pytest.approx(0.5, rel=1e-12)
+    assert float(values['body rate error (rel.)']) < 1e-9
+    level, message, values = newest(probe, 'conservation')
+    assert level == DiagnosticStatus.OK
+    assert probe.call(Trigger, '/attitude_analyzer/reset_baseline', Trigger.Request()).success
+    stop_cleanly(analyzer)
+
+
+def test_without_inertia_nothing_is_made_up(launch, probe):
+    analyzer = launch(ANALYZER, name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    rates = probe.subscribe(Float64, 'precession/body_rate')
+    energy = probe.subscribe(Float64, 'kinetic_energy')
+    pub = probe.publisher(Odometry, 'odom')
+    body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    _publish_states(probe, pub, np.arange(0.0, 3.0, 0.01), body)
+    probe.spin_for(2.5)
+    level, message, values = newest(probe, 'precession')
+    assert 'no inertia' in message and level == DiagnosticStatus.WARN
+    assert not rates and not energy
+    level, message, values = newest(probe, 'input')
+    assert values['inertia source'] == 'none'
+    stop_cleanly(analyzer)
+
+
+def test_bad_parameters_are_refused(launch):
+    proc = launch(ANALYZER, '-p', 'inertia:=[1.0, 1.0, 3.0]', name='bad')
+    assert proc.wait(20.0) == 1
+    assert 'triangle inequality' in proc.output()
