@@ -1,12 +1,13 @@
 """
-The main job: run the simulator node, watch its topics, print what the motion does.
+The main job: run both nodes on a built-in body and print what the analysis finds.
 
-``rigid_body_demo`` starts ``attitude_simulator`` as its own process on the
-default body (DDS kept on this machine, a free domain id if none is set),
-records its state topics for a stretch of simulated time, measures the
-precession rates and conservation from them, prints that beside theory, and
-stops the node with Ctrl-C's signal. ``--offline`` does the same without ROS,
-straight from the physics layer.
+``rigid_body_demo`` starts ``attitude_simulator`` and ``attitude_analyzer`` as
+their own processes (DDS kept on this machine, a free domain id if none is
+set), waits until the analyzer's diagnostics hold a full window of
+measurements, prints them beside theory in a few lines, and stops both nodes
+with Ctrl-C's signal: first the default symmetric top (precession rates,
+conservation), then the tennis racket (instability, growth rate, flips).
+``--offline`` measures the same straight from the physics layer, without ROS.
 """
 
 import argparse
@@ -26,12 +27,11 @@ def _line(label, measured, predicted, unit):
     return f'  {label:<34} {measured:>+.10f} {unit:<6} theory {predicted:>+.10f}  (rel. {rel:.1e})'
 
 
-def report(preset, integrator, duration, dt, run=None):
-    """Compare a run of ``preset`` (simulated here unless given) with theory; returns lines."""
+def report(preset, integrator, duration, dt):
+    """Simulate ``preset`` offline and compare with theory; returns the lines."""
     body = presets.get(preset)
     moments = np.array(body.moments)
-    if run is None:
-        run = simulate(moments, body.omega0, body.q0, duration, dt, integrator=integrator)
+    run = simulate(moments, body.omega0, body.q0, duration, dt, integrator=integrator)
     lines = [f'{body.name}: {body.description}',
              f'  I = {body.moments} kg m^2, omega0 = {body.omega0} rad/s body, '
              f'{integrator}, dt = {dt} s, {run.t[-1] - run.t[0]:.4g} s of samples']
@@ -65,75 +65,129 @@ def report(preset, integrator, duration, dt, run=None):
     return lines
 
 
-class Recording:
-    """Samples recorded from the topics: the same fields simulate() returns."""
+#: What the demo waits for in the analyzer's diagnostics, per kind of body.
+_READY = {
+    'axisymmetric': ('precession', 'lab rate error (rel.)'),
+    'asymmetric': ('stability', 'flip interval, measured (s)'),
+}
 
-    def __init__(self, t, q, omega):
-        self.t, self.q, self.omega = t, q, omega
+
+def _number(text):
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return None
 
 
-def record_from_node(preset, integrator, duration, rate):
+def findings(statuses):
+    """Readable lines from the analyzer's newest statuses (name -> (level, message, values))."""
+    lines = []
+    pre = statuses.get('precession')
+    if pre and 'body rate, measured (rad/s)' in pre[2]:
+        v = pre[2]
+        for label, key in (('body precession Omega (rad/s)', 'body rate'),
+                           ('lab precession |L|/I1 (rad/s)', 'lab rate')):
+            lines.append(_line(label, float(v[f'{key}, measured (rad/s)']),
+                               float(v[f'{key}, theory (rad/s)']), ''))
+    stab = statuses.get('stability')
+    if stab:
+        v = stab[2]
+        lines.append(f'  stability: {stab[1]}')
+        for label, key in (('growth rate (1/s)', 'growth rate'),
+                           ('flip interval (s)', 'flip interval')):
+            unit = '(1/s)' if key == 'growth rate' else '(s)'
+            measured = _number(v.get(f'{key}, measured {unit}'))
+            if measured is not None:
+                lines.append(_line(label, measured, float(v[f'{key}, theory {unit}']), ''))
+    cons = statuses.get('conservation')
+    if cons:
+        v = cons[2]
+        drift = ', '.join(f'{k.split(" since")[0]} {float(v[k]):.1e}' for k in v
+                          if 'since baseline' in k)
+        lines.append(f'  conservation: {cons[1]} ({drift})')
+    return lines
+
+
+def run_nodes(preset, integrator, rate):
     """
-    Start attitude_simulator, record ``duration`` s of simulated time from odom, stop it.
+    Start attitude_simulator and attitude_analyzer, wait for the analyzer's findings, stop both.
 
-    Runs at real-time factor 4 with stamps = simulated time (publish_clock),
-    recording from the first message that arrives (after DDS discovery).
+    The simulator runs at 4x (axisymmetric) or 8x real time with stamps =
+    simulated time; the analyzer's window is sized to a few periods of what
+    the body does. Returns the printable lines.
     """
     import rclpy
     from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from nav_msgs.msg import Odometry
+    from diagnostic_msgs.msg import DiagnosticArray
 
-    from .nodes.conversions import quaternion_array, vector_array
-    rtf = 4.0
-    cmd = [sys.executable, '-m', 'rigid_body_dynamics.nodes.simulator', '--ros-args',
-           '-p', f'preset:={preset}', '-p', f'integrator:={integrator}',
-           '-p', f'integration_rate:={rate}', '-p', f'real_time_factor:={rtf}',
-           '-p', 'publish_clock:=true', '--log-level', 'warn']
-    node_proc = subprocess.Popen(cmd)
+    from .nodes.conversions import status_values
+    body = presets.get(preset)
+    kind = FreeRigidBody(body.moments, body.omega0).shape.kind
+    check, key = _READY.get(kind, ('conservation', 'mode'))
+    window = 50.0 if kind == 'asymmetric' else 10.0
+    rtf = 8.0 if kind == 'asymmetric' else 4.0
+    def start(node, *params):
+        cmd = [sys.executable, '-m', f'rigid_body_dynamics.nodes.{node}', '--ros-args',
+               '--log-level', 'warn']
+        for p in params:
+            cmd += ['-p', p]
+        return subprocess.Popen(cmd)
+    sim = start('simulator', f'preset:={preset}', f'integrator:={integrator}',
+                f'integration_rate:={rate}', f'real_time_factor:={rtf}', 'publish_clock:=true')
+    analyzer = start('analyzer', f'window:={window}')
+    print(f'{preset}: started attitude_simulator (pid {sim.pid}, {integrator}, {rtf:g}x real '
+          f'time) and attitude_analyzer (pid {analyzer.pid}, window {window:g} s) ...',
+          flush=True)
     ctx = Context()
     rclpy.init(context=ctx)
     node = rclpy.create_node('rigid_body_demo', context=ctx)
     executor = SingleThreadedExecutor(context=ctx)
     executor.add_node(node)
-    samples = []
-    node.create_subscription(Odometry, 'odom', samples.append,
-                             QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE))
-    print(f'started attitude_simulator (pid {node_proc.pid}, preset {preset}, {integrator}); '
-          f'recording {duration:g} s of simulated time at {rtf:g}x real time ...', flush=True)
-    deadline = time.monotonic() + 30.0 + duration / rtf
+    statuses = {}
+    first = {}
 
-    def sim_time():
-        h = samples[-1].header.stamp
-        return h.sec + 1e-9 * h.nanosec
-
-    def recorded():
-        first = samples[0].header.stamp
-        return sim_time() - (first.sec + 1e-9 * first.nanosec)
+    def on_diagnostics(msg):
+        for st in msg.status:
+            if st.name.startswith('attitude_analyzer: '):
+                values = status_values(st)
+                name = st.name.split(': ', 1)[1]
+                statuses[name] = (st.level, st.message, values)
+                if key in values and _number(values[key]) is not None:
+                    first.setdefault(name, time.monotonic())
+    node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 10)
+    deadline = time.monotonic() + 60.0 + window / rtf
     try:
-        while (not samples or recorded() < duration) and time.monotonic() < deadline:
-            if node_proc.poll() is not None:
-                raise RuntimeError(f'attitude_simulator exited with code {node_proc.returncode}')
+        # findings are ready once the window is full: a window's worth of wall time after
+        # the first estimate
+        while time.monotonic() < deadline:
+            if check in first and time.monotonic() > first[check] + window / rtf + 1.0:
+                break
+            for proc, name in ((sim, 'attitude_simulator'), (analyzer, 'attitude_analyzer')):
+                if proc.poll() is not None:
+                    raise RuntimeError(f'{name} exited with code {proc.returncode}')
             executor.spin_once(timeout_sec=0.05)
     finally:
         executor.shutdown()
         node.destroy_node()
         rclpy.shutdown(context=ctx)
-        if node_proc.poll() is None:
-            node_proc.send_signal(signal.SIGINT)
-            try:
-                node_proc.wait(10.0)
-            except subprocess.TimeoutExpired:
-                node_proc.kill()
-    if not samples or recorded() < duration:
-        raise RuntimeError('no state arrived from attitude_simulator in time')
-    print(f'stopped attitude_simulator (exit code {node_proc.returncode}); '
-          f'{len(samples)} odom messages', flush=True)
-    t = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for m in samples])
-    q = np.array([quaternion_array(m.pose.pose.orientation) for m in samples])
-    w = np.array([vector_array(m.twist.twist.angular) for m in samples])
-    return Recording(t, q, w)
+        codes = []
+        for proc in (analyzer, sim):
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGINT)
+                try:
+                    proc.wait(10.0)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+            codes.append(proc.returncode)
+    if check not in first:
+        raise RuntimeError('the analyzer reported no findings in time')
+    lines = [f'{body.name}: {body.description}',
+             f'  I = {body.moments} kg m^2, omega0 = {body.omega0} rad/s body; '
+             'attitude_analyzer finds:'] + findings(statuses)
+    lines.append(f'  stopped attitude_analyzer and attitude_simulator (exit codes {codes[0]}, '
+                 f'{codes[1]})')
+    return lines
 
 
 def _ros_environment():
@@ -153,7 +207,8 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     parser.add_argument('--preset', default=None, help='preset name (default: a tour of several)')
     parser.add_argument('--integrator', default='exact', choices=sorted(INTEGRATORS))
-    parser.add_argument('--duration', type=float, default=None, help='simulated seconds')
+    parser.add_argument('--duration', type=float, default=None,
+                        help='simulated seconds (--offline)')
     parser.add_argument('--dt', type=float, default=1e-3, help='step (s)')
     parser.add_argument('--offline', action='store_true', help='physics only, no ROS nodes')
     args = parser.parse_args(argv)
@@ -162,11 +217,11 @@ def main(argv=None):
     try:
         for name in names:
             body = presets.get(name)
-            duration = args.duration or body.duration
-            run = None
-            if not args.offline:
-                run = record_from_node(name, args.integrator, duration, 1.0 / args.dt)
-            print('\n'.join(report(name, args.integrator, duration, args.dt, run)), flush=True)
+            if args.offline:
+                lines = report(name, args.integrator, args.duration or body.duration, args.dt)
+            else:
+                lines = run_nodes(name, args.integrator, 1.0 / args.dt)
+            print('\n'.join(lines), flush=True)
     except (ValueError, RuntimeError) as err:
         print(f'rigid_body_demo: {err}', file=sys.stderr)
         return 2
