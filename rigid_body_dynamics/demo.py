@@ -127,6 +127,7 @@ def run_nodes(preset, integrator, rate):
     check, key = _READY.get(kind, ('conservation', 'mode'))
     window = 50.0 if kind == 'asymmetric' else 10.0
     rtf = 8.0 if kind == 'asymmetric' else 4.0
+
     def start(node, *params):
         cmd = [sys.executable, '-m', f'rigid_body_dynamics.nodes.{node}', '--ros-args',
                '--log-level', 'warn']
