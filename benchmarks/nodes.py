@@ -27,6 +27,7 @@ sys.path.insert(0, os.path.join(HERE, '..', 'test'))
 from ros_harness import Probe  # noqa: E402
 
 SIM = [sys.executable, '-m', 'rigid_body_dynamics.nodes.simulator', '--ros-args']
+ANALYZER = [sys.executable, '-m', 'rigid_body_dynamics.nodes.analyzer', '--ros-args']
 FLOOR_TIMER = textwrap.dedent("""
     import rclpy
     from rclpy.clock import Clock, ClockType
@@ -82,15 +83,17 @@ def script(source):
     return [sys.executable, '-c', source]
 
 
-def measure_cpu(cmd, probe, warmup=3.0, window=8.0):
+def measure_cpu(cmd, probe, warmup=3.0, window=8.0, companions=(), status='integrator'):
     """
     CPU fraction of one core over ``window`` s after ``warmup``, and the diagnostics seen.
 
-    Returns (cpu, values of the integrator status at the start and at the end
-    of the window, or None for processes without diagnostics).
+    ``companions`` are started first and not measured (e.g. the simulator feeding
+    the analyzer). Returns (cpu, values of the newest ``status`` at the start
+    and at the end of the window, or None for processes without diagnostics).
     """
     diags = probe.messages.setdefault('/diagnostics', [])
     diags.clear()
+    others = [Process(c) for c in companions]
     proc = Process(cmd)
     try:
         probe.spin_for(warmup)
@@ -98,11 +101,13 @@ def measure_cpu(cmd, probe, warmup=3.0, window=8.0):
         c0, t0 = cpu_seconds(proc.proc.pid), time.monotonic()
         probe.spin_for(window)
         cpu = (cpu_seconds(proc.proc.pid) - c0) / (time.monotonic() - t0)
-        status = [status_values(s) for a in diags[max(first - 1, 0):] for s in a.status
-                  if s.name.endswith('integrator')]
-        return cpu, (status[0], status[-1]) if len(status) >= 2 else None
+        found = [status_values(s) for a in diags[max(first - 1, 0):] for s in a.status
+                 if s.name.endswith(status)]
+        return cpu, (found[0], found[-1]) if len(found) >= 2 else None
     finally:
         proc.close()
+        for other in others:
+            other.close()
 
 
 #: A rate counts as sustained when the achieved real-time factor is at least 0.99 of
@@ -128,8 +133,20 @@ def sim(*params):
     return cmd
 
 
-def latency(cmd, probe, commands=100, period=0.05):
-    """Measure the time (s) from publishing torque_cmd to receiving applied_torque with it."""
+def latency(cmd, commands=200, period=0.05):
+    """
+    Measure the time (s) from publishing torque_cmd to receiving applied_torque with it.
+
+    A fresh probe subscribes to nothing else, so its own executor adds no backlog.
+    """
+    probe = Probe('bench_latency')
+    try:
+        return _latency(cmd, probe, commands, period)
+    finally:
+        probe.close()
+
+
+def _latency(cmd, probe, commands, period):
     arrivals = {}
     probe.node.create_subscription(
         WrenchStamped, 'applied_torque',
@@ -225,12 +242,9 @@ def measure(quick=False):
                 lines.append(f'| {label} | {name} | {speed:.1f} |')
         lines.append('')
 
-        ours = latency(sim('publish_rate:=1000.0', 'torque_timeout:=0.0'), probe)
-        probe2 = Probe('bench_relay')
-        try:
-            floor = latency(script(FLOOR_RELAY), probe2)
-        finally:
-            probe2.close()
+        lines += analyzer_lines(probe, window)
+        ours = latency(sim('publish_rate:=1000.0', 'torque_timeout:=0.0'))
+        floor = latency(script(FLOOR_RELAY))
         lines += ['### Latency from torque_cmd to the first applied_torque carrying it', '',
                   'Both measured by one process that publishes the command and subscribes to '
                   'the answer (1 kHz integration and publishing: one step is 1 ms).', '',
@@ -242,3 +256,16 @@ def measure(quick=False):
     finally:
         probe.close()
     return lines
+
+
+def analyzer_lines(probe, window):
+    """CPU of attitude_analyzer fed by the simulator at 100 Hz and 1 kHz (default window)."""
+    lines = ['### attitude_analyzer: CPU against input rate (default 10 s window, 1 Hz analysis)',
+             '', '| odom rate (Hz) | analyzer CPU (% of one core) | rate the analyzer received '
+             '(Hz) |', '|---|---|---|']
+    for rate in (100, 1000):
+        cpu, diag = measure_cpu(ANALYZER, probe, warmup=12.0, window=window, status='input',
+                                companions=[sim(f'publish_rate:={rate}.0')])
+        received = float(diag[1]['rate (Hz)']) if diag else float('nan')
+        lines.append(f'| {rate} | {100 * cpu:.1f} | {received:.0f} |')
+    return lines + ['']
