@@ -12,6 +12,8 @@ from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
+from rcl_interfaces.srv import SetParametersAtomically
+from rclpy.parameter import Parameter
 from rigid_body_dynamics.nodes.conversions import quaternion_msg, status_values, time_msg
 from rigid_body_dynamics.nodes.conversions import vector_msg
 from rigid_body_dynamics.physics import FreeRigidBody, presets, theory
@@ -47,6 +49,14 @@ def is_number(text):
     except (TypeError, ValueError):
         return False
     return True
+
+
+def set_params(probe, **values):
+    """Set the analyzer's parameters atomically; returns the SetParametersResult."""
+    request = SetParametersAtomically.Request(parameters=[
+        Parameter(name, value=value).to_parameter_msg() for name, value in values.items()])
+    return probe.call(SetParametersAtomically, '/attitude_analyzer/set_parameters_atomically',
+                      request).result
 
 
 def stop_cleanly(*procs):
@@ -118,6 +128,13 @@ def test_tennis_racket_is_unstable_with_measured_growth_and_flips(launch, probe)
         theory.separatrix_growth_rate(body.moments, body.omega0), rel=0.02)
     assert float(values['flip interval, measured (s)']) == pytest.approx(
         theory.flip_interval(body.moments, body.omega0), rel=0.02)
+    level, message, values = wait_status(
+        probe, 'precession', lambda v: 'omega period error (rel.)' in v, 30.0,
+        'a full period of omega in the window')
+    assert float(values['omega period error (rel.)']) < 1e-3
+    measured = float(values['mean precession of axis 3 about L, measured (rad/s)'])
+    assert measured == pytest.approx(
+        theory.mean_precession_rate(body.moments, body.omega0, 2), rel=0.02)
     stop_cleanly(analyzer, sim)
 
 
@@ -235,6 +252,17 @@ def test_without_inertia_nothing_is_made_up(launch, probe):
     assert not rates and not energy
     level, message, values = newest(probe, 'input')
     assert values['inertia source'] == 'none'
+    # parameters are validated with a reason, then applied
+    refused = set_params(probe, inertia=[1.0, 1.0, 3.0])
+    assert not refused.successful and 'triangle' in refused.reason
+    refused = set_params(probe, window=-1.0)
+    assert not refused.successful and 'window' in refused.reason
+    assert set_params(probe, inertia=[1.0, 1.0, 1.5]).successful
+    _publish_states(probe, pub, np.arange(3.0, 6.0, 0.01), body)
+    level, message, values = wait_status(
+        probe, 'precession', lambda v: 'body rate error (rel.)' in v, 20.0, 'estimates')
+    assert float(values['body rate error (rel.)']) < 1e-9
+    assert newest(probe, 'input')[2]['inertia source'] == 'parameter'
     stop_cleanly(analyzer)
 
 

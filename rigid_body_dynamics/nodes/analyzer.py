@@ -154,6 +154,7 @@ class AttitudeAnalyzer(Node):
         self._last_arrival = None
         self._rate_window = []
         self.add_on_set_parameters_callback(self._on_set_parameters)
+        self.add_post_set_parameters_callback(self._post_set_parameters)
 
         self.create_subscription(Odometry, 'odom', self._on_odom, INPUT_QOS)
         self.create_subscription(WrenchStamped, 'applied_torque', self._on_torque, INPUT_QOS)
@@ -191,22 +192,19 @@ class AttitudeAnalyzer(Node):
         return out
 
     def _on_set_parameters(self, params):
+        """Validate only (no side effects); the post-set callback applies."""
         values = {p.name: p.value for p in self._parameters.values()}
         values.update({p.name: p.value for p in params})
         try:
-            settings = self._validate(values)
+            self._validate(values)
         except ConfigurationError as err:
+            self.get_logger().warn(f'parameter change refused: {err}')
             return SetParametersResult(successful=False, reason=str(err))
-        # no side effects here beyond keeping the validated copy for the next analysis
-        self._pending = settings
         return SetParametersResult(successful=True)
 
-    def _apply_pending(self):
-        settings = getattr(self, '_pending', None)
-        if settings is None:
-            return
-        self._pending = None
-        if settings['inertia'] is not None and settings['inertia'] is not self._inertia:
+    def _post_set_parameters(self, params):
+        settings = self._validate({p.name: p.value for p in self._parameters.values()})
+        if 'inertia' in {p.name for p in params} and settings['inertia'] is not None:
             self._inertia, self._inertia_source = settings['inertia'], 'parameter'
             self._restart('inertia changed')
         self._settings = settings
@@ -262,7 +260,6 @@ class AttitudeAnalyzer(Node):
 
     # ---------------------------------------------------------------- analysis
     def _analyse(self):
-        self._apply_pending()
         s = self._settings
         name = self.get_name()
         hw = self.get_fully_qualified_name()
@@ -379,17 +376,7 @@ class AttitudeAnalyzer(Node):
             return conv.status(f'{name}: precession', OK, 'a spherical body does not precess',
                                values, hw)
         if axis is None:
-            period = theory.omega_period(moments, w[-1])
-            mid = int(np.argsort(moments)[1])
-            values.append(('omega period, theory (s)', period))
-            try:
-                measured = estimators.crossing_period(t, w[:, mid] - w[:, mid].mean(), 0)
-                values.append(('omega period, measured (s)', measured))
-                values.append(('relative error', abs(measured - period) / period))
-                msg = f'omega period {measured:.6g} s (theory {period:.6g} s)'
-            except ValueError:
-                msg = 'asymmetric body: window shorter than a period of omega'
-            return conv.status(f'{name}: precession', OK, msg, values, hw)
+            return self._asymmetric_precession(name, hw, t, q, w, moments)
         i_perp = float(np.mean([moments[(axis + 1) % 3], moments[(axis + 2) % 3]]))
         w_axis = float(w[-1, axis])
         w_perp = float(math.hypot(w[-1, (axis + 1) % 3], w[-1, (axis + 2) % 3]))
@@ -414,6 +401,42 @@ class AttitudeAnalyzer(Node):
         return conv.status(f'{name}: precession', OK,
                            f'body {body_rate:.6g} rad/s (theory {body_theory:.6g}), '
                            f'lab {lab_rate:.6g} rad/s (theory {lab_theory:.6g})', values, hw)
+
+    def _asymmetric_precession(self, name, hw, t, q, w, moments):
+        """
+        Period of omega(t) and mean precession about L of the axis the polhode circles.
+
+        Both are measured only once the window spans a full period of omega
+        (a shorter window would alias the nutation into the rates).
+        """
+        period = theory.omega_period(moments, w[-1])
+        polhode = theory.polhode(moments, w[-1])
+        values = [('polhode family', polhode.family), ('omega period, theory (s)', period)]
+        if not math.isfinite(period) or polhode.circled_axis is None:
+            return conv.status(f'{name}: precession', OK,
+                               f'no periodic precession ({polhode.family})', values, hw)
+        axis = polhode.circled_axis
+        mean_rate = theory.mean_precession_rate(moments, w[-1], axis)
+        values.append((f'mean precession of axis {axis + 1} about L, theory (rad/s)', mean_rate))
+        if t[-1] - t[0] < period:
+            return conv.status(f'{name}: precession', OK,
+                               f'window ({t[-1] - t[0]:.3g} s) shorter than a period of omega '
+                               f'({period:.6g} s): no measurement yet', values, hw)
+        # omega about the middle axis is a2 sn(u) in both families: its zero crossings
+        # are exactly half a period apart (no mean to remove)
+        mid = int(np.argsort(moments)[1])
+        try:
+            measured = estimators.crossing_period(t, w[:, mid], 0)
+        except ValueError:
+            measured = math.nan
+        lab = estimators.lab_precession_rate(t, q, w, moments, axis).rate
+        values += [('omega period, measured (s)', measured),
+                   ('omega period error (rel.)', abs(measured - period) / period),
+                   (f'mean precession of axis {axis + 1} about L, measured (rad/s)', lab)]
+        return conv.status(f'{name}: precession', OK,
+                           f'omega period {measured:.6g} s (theory {period:.6g}), axis '
+                           f'{axis + 1} precesses about L at {lab:.6g} rad/s (theory '
+                           f'{mean_rate:.6g})', values, hw)
 
     def _stability(self, name, hw, t, w, moments):
         """
@@ -461,6 +484,12 @@ def main(args=None):
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except RuntimeError:
+        # rclpy can fail to take a message while a signal shuts the context
+        # down under it (cf. ros/joint_state_publisher#117); that is a shutdown,
+        # anything else is a real failure.
+        if rclpy.ok():
+            raise
     except (ConfigurationError, InvalidParameterValueException,
             InvalidParameterTypeException) as err:
         rclpy.logging.get_logger(NODE_NAME).fatal(f'cannot start: {err}')

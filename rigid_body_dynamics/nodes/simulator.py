@@ -616,6 +616,12 @@ def main(args=None):
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except RuntimeError:
+        # rclpy can fail to take a message while a signal shuts the context
+        # down under it (cf. ros/joint_state_publisher#117); that is a shutdown,
+        # anything else is a real failure.
+        if rclpy.ok():
+            raise
     except (ConfigurationError, InvalidParameterValueException,
             InvalidParameterTypeException) as err:
         rclpy.logging.get_logger(NODE_NAME).fatal(f'cannot start: {err}')
