@@ -288,6 +288,6 @@ def analyzer_lines(probe, window):
                                companions=source)
         received = float(diag[1]['rate (Hz)']) if diag else float('nan')
         lines.append(f'| {rate} | {100 * cpu:.1f} | {received:.0f} | {100 * floor:.1f} |')
-    return lines + ['', 'The analyzer\'s own work is about 11 us per message and 10 ms per '
+    return lines + ['', "The analyzer's own work is about 11 us per message and 10 ms per "
                     'analysis of a full 10 s window at 1 kHz (measured in-process); the rest '
-                    'is rclpy\'s per-callback cost, which the floor shows.', '']
+                    "is rclpy's per-callback cost, which the floor shows.", '']
