@@ -23,10 +23,7 @@ from geometry_msgs.msg import InertiaStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
 from rclpy.clock import Clock, ClockType
-from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64
@@ -34,6 +31,7 @@ from std_srvs.srv import Trigger
 
 from . import conversions as conv
 from .parameters import as_float, as_vector, ConfigurationError, descriptor
+from .runner import run
 from ..physics import equations, estimators, Inertia, theory
 
 NODE_NAME = 'attitude_analyzer'
@@ -475,30 +473,8 @@ class AttitudeAnalyzer(Node):
 
 
 def main(args=None):
-    """Console entry point: run the analyzer until Ctrl-C / SIGTERM; exit 0, or 1 on bad config."""
-    rclpy.init(args=args)
-    node = None
-    code = 0
-    try:
-        node = AttitudeAnalyzer()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except RuntimeError:
-        # rclpy can fail to take a message while a signal shuts the context
-        # down under it (cf. ros/joint_state_publisher#117); that is a shutdown,
-        # anything else is a real failure.
-        if rclpy.ok():
-            raise
-    except (ConfigurationError, InvalidParameterValueException,
-            InvalidParameterTypeException) as err:
-        rclpy.logging.get_logger(NODE_NAME).fatal(f'cannot start: {err}')
-        code = 1
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return code
+    """Console entry point: run until Ctrl-C / SIGTERM; exit 0, or 1 on bad configuration."""
+    return run(AttitudeAnalyzer, NODE_NAME, args)
 
 
 if __name__ == '__main__':

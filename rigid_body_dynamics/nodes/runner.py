@@ -1,0 +1,61 @@
+"""
+Run a node as a process: clean exit on Ctrl-C / SIGTERM, exit code 1 on bad configuration.
+
+rclpy's own SIGINT handling raises KeyboardInterrupt wherever the main
+thread happens to be, inside a garbage-collector finalizer included ("Exception
+ignored in Task.__del__" on stderr), and can race a message take against the
+context shutdown. Here the signals only set a flag; the executor spins in
+short slices and checks it, so shutdown always happens between callbacks.
+"""
+
+import signal
+import threading
+
+import rclpy
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
+
+from .parameters import ConfigurationError
+
+#: Longest time between two looks at the stop flag (s).
+SLICE = 0.1
+
+
+def run(make_node, name, args=None, on_start=None, on_stop=None):
+    """
+    Create the node with ``make_node()`` and spin it until SIGINT / SIGTERM.
+
+    ``on_start(node)`` / ``on_stop(node)`` run after creation / before
+    destruction. Returns the process exit code: 0, or 1 when the node refused
+    its configuration (the reason is logged).
+    """
+    stop = threading.Event()
+    previous = {sig: signal.signal(sig, lambda *_: stop.set())
+                for sig in (signal.SIGINT, signal.SIGTERM)}
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    node = None
+    code = 0
+    try:
+        node = make_node()
+        if on_start:
+            on_start(node)
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        while not stop.is_set() and rclpy.ok():
+            executor.spin_once(timeout_sec=SLICE)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except (ConfigurationError, InvalidParameterValueException,
+            InvalidParameterTypeException) as err:
+        rclpy.logging.get_logger(name).fatal(f'cannot start: {err}')
+        code = 1
+    finally:
+        if node is not None:
+            if on_stop:
+                on_stop(node)
+            node.destroy_node()
+        rclpy.try_shutdown()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    return code
