@@ -22,7 +22,6 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import InertiaStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
-from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -30,7 +29,7 @@ from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
 from . import conversions as conv
-from .parameters import as_float, as_vector, ConfigurationError, descriptor
+from .parameters import as_float, as_vector, check_change, ConfigurationError, descriptor
 from .runner import run
 from ..physics import equations, estimators, Inertia, theory
 
@@ -193,12 +192,7 @@ class AttitudeAnalyzer(Node):
         """Validate only (no side effects); the post-set callback applies."""
         values = {p.name: p.value for p in self._parameters.values()}
         values.update({p.name: p.value for p in params})
-        try:
-            self._validate(values)
-        except ConfigurationError as err:
-            self.get_logger().warn(f'parameter change refused: {err}')
-            return SetParametersResult(successful=False, reason=str(err))
-        return SetParametersResult(successful=True)
+        return check_change(self.get_logger(), self._validate, values)
 
     def _post_set_parameters(self, params):
         settings = self._validate({p.name: p.value for p in self._parameters.values()})

@@ -9,7 +9,7 @@ then checked here, with a reason for every refusal.
 
 import math
 
-from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
+from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
 
 
 class ConfigurationError(ValueError):
@@ -50,3 +50,18 @@ def as_vector(name, value, size):
     if len(items) != size:
         raise ConfigurationError(f'{name} must have {size} numbers, got {len(items)}')
     return tuple(as_float(f'{name}[{i}]', v) for i, v in enumerate(items))
+
+
+def check_change(logger, validate, values):
+    """
+    Run ``validate(values)`` for an on-set-parameters callback, without side effects.
+
+    Returns a successful SetParametersResult, or a refused one whose reason is
+    the ConfigurationError's message (also logged as a warning).
+    """
+    try:
+        validate(values)
+    except ConfigurationError as err:
+        logger.warn(f'parameter change refused: {err}')
+        return SetParametersResult(successful=False, reason=str(err))
+    return SetParametersResult(successful=True)

@@ -25,7 +25,6 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import InertiaStamped, QuaternionStamped, Vector3Stamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
-from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
@@ -37,7 +36,7 @@ from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
 from . import conversions as conv
-from .parameters import as_float, as_vector, ConfigurationError, descriptor
+from .parameters import as_float, as_vector, check_change, ConfigurationError, descriptor
 from .runner import run
 from ..physics import Inertia, INTEGRATORS, make_integrator, presets, quaternions
 
@@ -215,12 +214,7 @@ class AttitudeSimulator(Node):
         for param in params:
             if param.name in values:
                 values[param.name] = param.value
-        try:
-            self._validate(values)
-        except ConfigurationError as err:
-            self.get_logger().warn(f'parameter change refused: {err}')
-            return SetParametersResult(successful=False, reason=str(err))
-        return SetParametersResult(successful=True)
+        return check_change(self.get_logger(), self._validate, values)
 
     def _post_set_parameters(self, params):
         names = {p.name for p in params}
