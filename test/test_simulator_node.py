@@ -248,9 +248,9 @@ def test_two_namespaces_remapping_and_clock(launch, probe):
     probe.wait_for('/clock', 20)
     assert inertia_a[0].inertia.izz == 1.5 and inertia_b[0].inertia.izz == 3.0
     assert_exact(truth_a, (1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
-    t_b, _, w_b = odom_arrays(odom_b)
-    _, w_ref = FreeRigidBody((1.0, 2.0, 3.0), (0.01, 2.0, 0.01)).state_at(t_b - t_b[0])
-    assert abs(w_b[0][1] - 2.0) < 0.1                  # b is the racket, not the top
+    _, _, w_b = odom_arrays(odom_b)
+    assert np.all(np.abs(w_b[:, 1]) > 1.0)             # b spins about axis 2: the racket
+    assert np.max(np.abs(w_b[:, 2])) < 1.0             # not the top (omega3 = 2 there)
     clock_t = [c.clock.sec + 1e-9 * c.clock.nanosec for c in clock]
     assert clock_t[-1] > clock_t[0] and np.all(np.diff(clock_t) > 0.0)
     stop_cleanly(a)
