@@ -28,6 +28,7 @@ setup(
             'rigid_body_demo = rigid_body_dynamics.demo:main',
             'attitude_simulator = rigid_body_dynamics.nodes.simulator:main',
             'attitude_analyzer = rigid_body_dynamics.nodes.analyzer:main',
+            'poinsot_visualizer = rigid_body_dynamics.nodes.poinsot:main',
         ],
     },
 )

@@ -1,5 +1,5 @@
 """
-Start attitude_simulator and attitude_analyzer on a preset (needs a full ROS 2 install).
+Start the simulator, the analyzer and the Poinsot markers on a preset (full ROS 2 install).
 
     ros2 launch rigid_body_dynamics attitude.launch.py preset:=tennis_racket
     ros2 launch rigid_body_dynamics attitude.launch.py namespace:=sat1 real_time_factor:=4.0
@@ -33,6 +33,8 @@ def generate_launch_description():
                               description='exact, exact4, rk4 or dop853'),
         DeclareLaunchArgument('publish_clock', default_value='false',
                               description='publish /clock from the simulator'),
+        DeclareLaunchArgument('marker_scale', default_value='1.0',
+                              description='Poinsot markers: m per rad/s'),
         Node(package='rigid_body_dynamics', executable='attitude_simulator',
              name='attitude_simulator', namespace=namespace, output='screen',
              parameters=[config, {
@@ -43,4 +45,7 @@ def generate_launch_description():
         Node(package='rigid_body_dynamics', executable='attitude_analyzer',
              name='attitude_analyzer', namespace=namespace, output='screen',
              parameters=[config]),
+        Node(package='rigid_body_dynamics', executable='poinsot_visualizer',
+             name='poinsot_visualizer', namespace=namespace, output='screen',
+             parameters=[{'scale': LaunchConfiguration('marker_scale')}]),
     ])

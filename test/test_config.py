@@ -15,6 +15,7 @@ import pytest
 import rclpy
 from rclpy.context import Context
 from rigid_body_dynamics.nodes.analyzer import AttitudeAnalyzer
+from rigid_body_dynamics.nodes.poinsot import PoinsotVisualizer
 from rigid_body_dynamics.nodes.simulator import AttitudeSimulator
 from rigid_body_dynamics.physics import presets
 from ros_harness import LATCHED
@@ -101,10 +102,12 @@ def _launch_nodes():
 
 def test_launch_file_sets_only_declared_parameters_of_installed_executables():
     nodes = _launch_nodes()
-    assert {n[0] for n in nodes} == {'attitude_simulator', 'attitude_analyzer'}
+    assert {n[0] for n in nodes} == {'attitude_simulator', 'attitude_analyzer',
+                                     'poinsot_visualizer'}
     setup = open(os.path.join(ROOT, 'setup.py')).read()
     declared = {'attitude_simulator': _declared(AttitudeSimulator),
-                'attitude_analyzer': _declared(AttitudeAnalyzer)}
+                'attitude_analyzer': _declared(AttitudeAnalyzer),
+                'poinsot_visualizer': _declared(PoinsotVisualizer)}
     for executable, package, keys in nodes:
         assert package == 'rigid_body_dynamics'
         assert f"'{executable} = rigid_body_dynamics.nodes." in setup

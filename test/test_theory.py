@@ -139,3 +139,25 @@ def test_separatrix_detection():
     assert theory.is_near_separatrix((1.0, 2.0, 3.0), (0.0, 2.0, 1e-6))
     assert not theory.is_near_separatrix((1.0, 2.0, 3.0), (0.01, 2.0, 0.01))
     assert theory.omega_period((1.0, 2.0, 3.0), (0.0, 2.0, 0.0)) == math.inf
+
+
+def test_poinsot_construction_tangency():
+    """Tangency: omega's tip is on the ellipsoid and on the invariant plane (normal L)."""
+    from rigid_body_dynamics.physics import poinsot
+    run = simulate((1.0, 2.0, 3.0), (0.4, 0.6, 1.5), (0.1, 0.2, 0.3, 0.9), duration=5.0,
+                   dt=1e-2)
+    for q, w in zip(run.q[::50], run.omega[::50]):
+        c = poinsot.construction((1.0, 2.0, 3.0), q, w)
+        body_tip = quaternions.rotate_inverse(c.orientation, c.omega)
+        assert np.sum((body_tip / c.semi_axes) ** 2) == pytest.approx(1.0, rel=1e-13)
+        assert float(c.omega @ c.normal) == pytest.approx(c.distance, rel=1e-13)
+        # the ellipsoid's normal at the tip, I omega, is the plane's normal
+        grad = quaternions.rotate(c.orientation, np.array([1.0, 2.0, 3.0]) * body_tip)
+        assert float(estimators.vector_angle(grad, c.normal)) < 1e-14
+    np.testing.assert_allclose(c.semi_axes * np.sqrt([1.0, 2.0, 3.0]),
+                               c.semi_axes[0] * np.ones(3), rtol=1e-14)
+    normal = np.array([0.3, -0.4, 0.5]) / np.linalg.norm([0.3, -0.4, 0.5])
+    np.testing.assert_allclose(quaternions.rotate(poinsot.plane_orientation(normal), [0, 0, 1]),
+                               normal, atol=1e-15)
+    with pytest.raises(ValueError, match='rest'):
+        poinsot.construction((1.0, 2.0, 3.0), (0, 0, 0, 1), (0.0, 0.0, 0.0))

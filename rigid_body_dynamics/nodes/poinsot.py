@@ -1,0 +1,170 @@
+"""
+poinsot_visualizer: the Poinsot construction as RViz markers, from odom and the body's inertia.
+
+Publishes ``poinsot_markers`` (visualization_msgs/MarkerArray) in the odom
+frame (``header.frame_id`` of odom; no TF is needed): the inertia ellipsoid
+(oriented with the body, semi-axes sqrt(2T / I_i)), omega and the normal from
+the origin to the invariant plane (along L), the invariant plane it touches at
+omega's tip, the polhode (omega's path on the ellipsoid, drawn on the current
+ellipsoid) and the herpolhode (omega's path on the plane). Lengths are omega in
+rad/s times ``scale`` (m per rad/s); traces keep the last ``trace_length``
+points. The geometry is :mod:`rigid_body_dynamics.physics.poinsot`.
+"""
+
+from collections import deque
+import sys
+
+from builtin_interfaces.msg import Duration
+from geometry_msgs.msg import InertiaStamped, Point
+from nav_msgs.msg import Odometry
+import numpy as np
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from std_msgs.msg import ColorRGBA
+from visualization_msgs.msg import Marker, MarkerArray
+
+from . import conversions as conv
+from .parameters import as_float, check_change, ConfigurationError, descriptor
+from .runner import run
+from ..physics import Inertia, poinsot, quaternions
+
+NODE_NAME = 'poinsot_visualizer'
+INPUT_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+                       reliability=ReliabilityPolicy.BEST_EFFORT)
+LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
+                         reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+COLORS = {'ellipsoid': (0.2, 0.5, 0.9, 0.35), 'omega': (0.9, 0.2, 0.2, 1.0),
+          'normal': (0.2, 0.8, 0.2, 1.0), 'plane': (0.8, 0.8, 0.2, 0.25),
+          'polhode': (1.0, 0.5, 0.0, 1.0), 'herpolhode': (0.6, 0.2, 0.8, 1.0)}
+IDS = {name: i for i, name in enumerate(COLORS)}
+
+
+def _point(v):
+    return Point(x=float(v[0]), y=float(v[1]), z=float(v[2]))
+
+
+class PoinsotVisualizer(Node):
+    """The poinsot_visualizer node; ``kwargs`` go to rclpy's Node."""
+
+    def __init__(self, **kwargs):
+        super().__init__(NODE_NAME, **kwargs)
+        num = {'dynamic_typing': True}
+        self.declare_parameter('scale', 1.0, descriptor(
+            'Marker length per rad/s of angular velocity (m per rad/s).', low=1e-12, high=1e12,
+            **num))
+        self.declare_parameter('trace_length', 2000, descriptor(
+            'Points kept in the polhode and herpolhode traces.', read_only=True))
+        self.declare_parameter('marker_rate', 20.0, descriptor(
+            'Marker arrays per second of odom stamps (Hz).', low=1e-6, high=1e4, **num))
+        self._scale = as_float('scale', self.get_parameter('scale').value, 1e-12, 1e12)
+        self._period = 1.0 / as_float('marker_rate', self.get_parameter('marker_rate').value,
+                                      1e-6, 1e4)
+        length = self.get_parameter('trace_length').value
+        if not isinstance(length, int) or length < 2:
+            raise ConfigurationError(f'trace_length must be an integer >= 2, got {length!r}')
+        self._polhode = deque(maxlen=length)      # body-frame omega (principal axes)
+        self._herpolhode = deque(maxlen=length)   # world-frame omega
+        self._inertia = None
+        self._last = None
+        self.add_on_set_parameters_callback(lambda params: check_change(
+            self.get_logger(), self._check, {p.name: p.value for p in params}))
+        self.add_post_set_parameters_callback(self._apply)
+        self.create_subscription(InertiaStamped, 'inertia', self._on_inertia, LATCHED_QOS)
+        self.create_subscription(Odometry, 'odom', self._on_odom, INPUT_QOS)
+        self._pub = self.create_publisher(MarkerArray, 'poinsot_markers', 10)
+        self.get_logger().info('waiting for the inertia topic and odom')
+
+    def _check(self, values):
+        if 'scale' in values:
+            as_float('scale', values['scale'], 1e-12, 1e12)
+        if 'marker_rate' in values:
+            as_float('marker_rate', values['marker_rate'], 1e-6, 1e4)
+
+    def _apply(self, params):
+        for p in params:
+            if p.name == 'scale':
+                self._scale = float(p.value)
+            elif p.name == 'marker_rate':
+                self._period = 1.0 / float(p.value)
+
+    def _on_inertia(self, msg):
+        i = msg.inertia
+        try:
+            self._inertia = Inertia.from_tensor([i.ixx, i.iyy, i.izz, i.ixy, i.ixz, i.iyz])
+        except ValueError as err:
+            self.get_logger().error(f'inertia topic refused: {err}')
+            return
+        self._polhode.clear()
+        self._herpolhode.clear()
+
+    def _on_odom(self, msg):
+        if self._inertia is None:
+            return
+        q = conv.quaternion_array(msg.pose.pose.orientation)
+        w = conv.vector_array(msg.twist.twist.angular)
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(w))) or np.linalg.norm(q) < 0.5:
+            return
+        t = conv.time_ns(msg.header.stamp) * 1e-9
+        if self._last is not None and t < self._last:      # time went back: a new run
+            self._polhode.clear()
+            self._herpolhode.clear()
+            self._last = None
+        q_p = self._inertia.attitude_to_principal(q / np.linalg.norm(q))
+        w_p = self._inertia.to_principal(w)
+        try:
+            geometry = poinsot.construction(self._inertia.moments, q_p, w_p)
+        except ValueError:
+            return
+        self._polhode.append(w_p)
+        self._herpolhode.append(geometry.omega)
+        if self._last is None or t >= self._last + self._period:
+            self._last = t
+            self._pub.publish(self._markers(msg.header, geometry))
+
+    def _marker(self, header, name, kind):
+        m = Marker(header=header, ns='poinsot', id=IDS[name], type=kind, action=Marker.ADD)
+        m.color = ColorRGBA(r=COLORS[name][0], g=COLORS[name][1], b=COLORS[name][2],
+                            a=COLORS[name][3])
+        m.pose.orientation.w = 1.0
+        m.lifetime = Duration(sec=0)
+        return m
+
+    def _markers(self, header, g):
+        """Build the marker array for one instant; see the module docstring."""
+        k = self._scale
+        out = []
+        ellipsoid = self._marker(header, 'ellipsoid', Marker.SPHERE)
+        ellipsoid.pose.orientation = conv.quaternion_msg(g.orientation)
+        ellipsoid.scale.x, ellipsoid.scale.y, ellipsoid.scale.z = (2.0 * k * g.semi_axes)
+        out.append(ellipsoid)
+        width = 0.02 * k * float(np.min(g.semi_axes))
+        for name, tip in (('omega', g.omega), ('normal', g.distance * g.normal)):
+            arrow = self._marker(header, name, Marker.ARROW)
+            arrow.points = [_point((0.0, 0.0, 0.0)), _point(k * tip)]
+            arrow.scale.x, arrow.scale.y, arrow.scale.z = width, 2.0 * width, 4.0 * width
+            out.append(arrow)
+        plane = self._marker(header, 'plane', Marker.CUBE)
+        plane.pose.position = _point(k * g.distance * g.normal)
+        plane.pose.orientation = conv.quaternion_msg(poinsot.plane_orientation(g.normal))
+        size = 4.0 * k * float(np.max(g.semi_axes))
+        plane.scale.x, plane.scale.y, plane.scale.z = size, size, 1e-3 * size
+        out.append(plane)
+        polhode = self._marker(header, 'polhode', Marker.LINE_STRIP)
+        body_points = np.array(self._polhode)
+        polhode.points = [_point(k * p) for p in quaternions.rotate(g.orientation, body_points)]
+        herpolhode = self._marker(header, 'herpolhode', Marker.LINE_STRIP)
+        herpolhode.points = [_point(k * p) for p in self._herpolhode]
+        for trace in (polhode, herpolhode):
+            trace.scale.x = width
+            out.append(trace)
+        return MarkerArray(markers=out)
+
+
+def main(args=None):
+    """Console entry point: run until Ctrl-C / SIGTERM; exit 0, or 1 on bad configuration."""
+    return run(PoinsotVisualizer, NODE_NAME, args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())
