@@ -29,6 +29,7 @@ setup(
             'attitude_simulator = rigid_body_dynamics.nodes.simulator:main',
             'attitude_analyzer = rigid_body_dynamics.nodes.analyzer:main',
             'poinsot_visualizer = rigid_body_dynamics.nodes.poinsot:main',
+            'rigid_body_report = rigid_body_dynamics.report:main',
         ],
     },
 )

@@ -54,7 +54,7 @@ class SimulationResult:
 
 
 def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
-             integrator='exact', torque=None, every=1):
+             integrator='exact', torque=None, every=1, progress=None):
     """
     Integrate the rigid body for ``duration`` s with fixed steps ``dt`` s.
 
@@ -63,8 +63,9 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     w) body -> world. ``torque`` is None (free), a constant 3-vector (N m) or
     a callable ``torque(t, q, omega)`` -> 3-vector evaluated at the start of
     each step and held over it. ``integrator`` is a name from INTEGRATORS.
-    ``every``: keep every n-th step. Returns a :class:`SimulationResult`
-    including t = 0.
+    ``every``: keep every n-th step. ``progress(fraction)``, if given, is
+    called about a hundred times as the run goes (for long runs). Returns a
+    :class:`SimulationResult` including t = 0.
     """
     inertia = as_inertia(inertia)
     n = int(round(duration / dt))
@@ -78,6 +79,7 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
         np.asarray(torque, dtype=float).reshape(3)
     principal_const = tuple(float(c) for c in inertia.to_principal(body_const))
     rows = n // every + 1
+    report_every = max(1, n // 100)
     t = np.empty(rows)
     q = np.empty((rows, 4))
     w = np.empty((rows, 3))
@@ -101,6 +103,8 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
             imp[r] = stepper.impulse
         if k < n:
             stepper.step(tp)
+        if progress is not None and (k % report_every == 0 or k == n):
+            progress(k / max(n, 1))
     q_user = inertia.attitude_to_body(q)
     return SimulationResult(t=t, q=q_user, omega=inertia.to_body(w), torque=tau, work=work,
                             impulse=imp, inertia=inertia, integrator=integrator)
