@@ -26,9 +26,9 @@ setup(
     entry_points={
         'console_scripts': [
             'rigid_body_demo = rigid_body_dynamics.demo:main',
-            'attitude_simulator = rigid_body_dynamics.nodes.simulator:main',
-            'attitude_analyzer = rigid_body_dynamics.nodes.analyzer:main',
-            'poinsot_visualizer = rigid_body_dynamics.nodes.poinsot:main',
+            'attitude_simulator = rigid_body_dynamics.nodes.entry:simulator',
+            'attitude_analyzer = rigid_body_dynamics.nodes.entry:analyzer',
+            'poinsot_visualizer = rigid_body_dynamics.nodes.entry:poinsot',
             'rigid_body_report = rigid_body_dynamics.report:main',
         ],
     },

@@ -466,9 +466,9 @@ class AttitudeAnalyzer(Node):
         return conv.status(f'{name}: stability', level, message, values, hw)
 
 
-def main(args=None):
-    """Console entry point: run until Ctrl-C / SIGTERM; exit 0, or 1 on bad configuration."""
-    return run(AttitudeAnalyzer, NODE_NAME, args)
+def main(args=None, early=None):
+    """Run until Ctrl-C / SIGTERM; exit 0, or 1 on bad configuration (see runner.run)."""
+    return run(AttitudeAnalyzer, NODE_NAME, args, early=early)
 
 
 if __name__ == '__main__':

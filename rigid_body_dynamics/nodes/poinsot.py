@@ -161,9 +161,9 @@ class PoinsotVisualizer(Node):
         return MarkerArray(markers=out)
 
 
-def main(args=None):
-    """Console entry point: run until Ctrl-C / SIGTERM; exit 0, or 1 on bad configuration."""
-    return run(PoinsotVisualizer, NODE_NAME, args)
+def main(args=None, early=None):
+    """Run until Ctrl-C / SIGTERM; exit 0, or 1 on bad configuration (see runner.run)."""
+    return run(PoinsotVisualizer, NODE_NAME, args, early=early)
 
 
 if __name__ == '__main__':

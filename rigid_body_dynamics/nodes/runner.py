@@ -22,23 +22,29 @@ from .parameters import ConfigurationError
 SLICE = 0.1
 
 
-def run(make_node, name, args=None, on_start=None, on_stop=None):
+def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
     """
     Create the node with ``make_node()`` and spin it until SIGINT / SIGTERM.
 
     ``on_start(node)`` / ``on_stop(node)`` run after creation / before
-    destruction. Returns the process exit code: 0, or 1 when the node refused
-    its configuration (the reason is logged).
+    destruction. ``early``: signals already received by an entry point (see
+    ``entry.py``); if any, the node stops at once. Returns the process exit
+    code: 0, or 1 when the node refused its configuration (the reason is
+    logged).
     """
     stop = threading.Event()
     previous = {sig: signal.signal(sig, lambda *_: stop.set())
                 for sig in (signal.SIGINT, signal.SIGTERM)}
+    if early:
+        stop.set()
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     code = 0
     try:
+        if stop.is_set():
+            return code
         node = make_node()
-        if on_start:
+        if on_start and not stop.is_set():
             on_start(node)
         executor = SingleThreadedExecutor()
         executor.add_node(node)

@@ -598,10 +598,10 @@ class AttitudeSimulator(Node):
         return response
 
 
-def main(args=None):
-    """Console entry point: run until Ctrl-C / SIGTERM; exit 0, or 1 on bad configuration."""
-    return run(AttitudeSimulator, NODE_NAME, args, on_start=lambda node: node.start(),
-               on_stop=lambda node: node.stop())
+def main(args=None, early=None):
+    """Run until Ctrl-C / SIGTERM; exit 0, or 1 on bad configuration (see runner.run)."""
+    return run(AttitudeSimulator, NODE_NAME, args, early=early,
+               on_start=lambda node: node.start(), on_stop=lambda node: node.stop())
 
 
 if __name__ == '__main__':

@@ -1,0 +1,82 @@
+"""
+Faults (issue 6): signals at any moment, a crashed analyzer, a restarted simulator.
+
+Node processes killed with SIGKILL here use UDP only
+(FASTDDS_BUILTIN_TRANSPORTS=UDPv4), so they leave no Fast DDS shared-memory
+files behind in /dev/shm.
+"""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+import pytest
+from rigid_body_dynamics.nodes.conversions import status_values
+
+SCRIPTS = os.path.join(sys.prefix, 'lib', 'rigid_body_dynamics')
+
+
+def newest(probe, check):
+    for array in reversed(probe.messages['/diagnostics']):
+        for st in array.status:
+            if st.name == f'attitude_analyzer: {check}':
+                return st.level, st.message, status_values(st)
+    return None
+
+
+@pytest.mark.skipif(not os.path.exists(os.path.join(SCRIPTS, 'attitude_simulator')),
+                    reason='console scripts not installed (run ./dev setup)')
+@pytest.mark.parametrize('delay', [0.15, 0.3, 0.5, 0.8, 1.2, 2.0])
+def test_signal_at_any_moment_exits_zero_without_traceback(delay, tmp_path):
+    """SIGINT or SIGTERM during imports, start-up or running: exit 0, no traceback."""
+    for name, sig in (('attitude_simulator', signal.SIGINT), ('attitude_analyzer',
+                                                              signal.SIGTERM)):
+        log = open(tmp_path / f'{name}.log', 'w')
+        proc = subprocess.Popen([os.path.join(SCRIPTS, name)], stdout=log,
+                                stderr=subprocess.STDOUT)
+        time.sleep(delay)
+        proc.send_signal(sig)
+        assert proc.wait(15.0) == 0, open(tmp_path / f'{name}.log').read()
+        log.close()
+        assert 'Traceback' not in open(tmp_path / f'{name}.log').read()
+
+
+def test_analyzer_crash_and_simulator_restart(launch, probe, monkeypatch):
+    """A killed analyzer restarts and recovers; a restarted simulator is detected."""
+    monkeypatch.setenv('FASTDDS_BUILTIN_TRANSPORTS', 'UDPv4')
+    sim = launch('rigid_body_dynamics.nodes.simulator', '-p', 'publish_clock:=true',
+                 '-p', 'real_time_factor:=4.0', name='sim')
+    analyzer = launch('rigid_body_dynamics.nodes.analyzer', '-p', 'window:=4.0',
+                      name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+
+    def good_estimate():
+        found = newest(probe, 'precession')
+        return found is not None and 'body rate error (rel.)' in found[2] and \
+            float(found[2]['body rate error (rel.)']) < 1e-6
+    probe.spin_until(good_estimate, 40.0, 'estimates')
+    analyzer.proc.kill()                                 # a crash: no clean shutdown
+    analyzer.proc.wait(5.0)
+    probe.messages['/diagnostics'].clear()
+    analyzer = launch('rigid_body_dynamics.nodes.analyzer', '-p', 'window:=4.0',
+                      name='analyzer2')
+    probe.spin_until(good_estimate, 40.0, 'estimates from the restarted analyzer')
+    assert newest(probe, 'input')[2]['inertia source'] == 'topic'   # latched inertia re-read
+    # now the simulator restarts under the running analyzer: its stamps go back to 0
+    code, _ = sim.stop()
+    assert code == 0
+    sim = launch('rigid_body_dynamics.nodes.simulator', '-p', 'publish_clock:=true',
+                 '-p', 'real_time_factor:=4.0', name='sim2')
+    probe.spin_until(lambda: newest(probe, 'input') is not None and int(
+        newest(probe, 'input')[2]['restarts after a time reset']) >= 1, 40.0,
+        'the time reset to be detected')
+    probe.messages['/diagnostics'].clear()
+    probe.spin_until(good_estimate, 40.0, 'estimates after the simulator restart')
+    level, _, _ = newest(probe, 'conservation')
+    assert level == DiagnosticStatus.OK
+    for proc in (analyzer, sim):
+        code, _ = proc.stop()
+        assert code == 0, proc.output()
