@@ -42,29 +42,49 @@ def main():
     parser.add_argument('--quick', action='store_true', help='1e5 steps instead of 1e6')
     parser.add_argument('--peers', action='store_true', help='also MuJoCo and Basilisk')
     parser.add_argument('--nodes', action='store_true', help='also the simulator node')
-    parser.add_argument('--only', choices=['nodes'], help='run only this section')
+    parser.add_argument('--only', choices=['nodes', 'soak'], help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
     machine = common.machine()
     sections = {}
 
-    if args.only == 'nodes':
-        args.nodes = True
+    if args.only == 'soak':
+        soak_section(sections, machine)
     else:
-        physics_sections(sections, steps, machine, args.peers)
-    if args.nodes:
-        node_section(sections, machine, args.quick)
+        if args.only == 'nodes':
+            args.nodes = True
+        else:
+            physics_sections(sections, steps, machine, args.peers)
+        if args.nodes:
+            node_section(sections, machine, args.quick)
     write(sections)
+
+
+def _own_domain():
+    """Keep DDS on this machine, in a domain id of our own."""
+    from domain_coordinator import domain_id
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    os.environ.pop('ROS_LOCALHOST_ONLY', None)
+    return domain_id()
+
+
+def soak_section(sections, machine):
+    """Soak both nodes for 1e7 steps and record memory and drift."""
+    import soak
+    print('soak (about 5 minutes) ...', flush=True)
+    with _own_domain() as domain:
+        os.environ['ROS_DOMAIN_ID'] = str(domain)
+        lines = soak.measure()
+    header = ['## Soak: 1e7 steps with both nodes', '', f'Measured {machine}.', '',
+              soak.__doc__.strip().replace('\n', ' '), '']
+    sections['soak'] = '\n'.join(header + lines)
 
 
 def node_section(sections, machine, quick):
     """Measure attitude_simulator as a process, in a DDS domain of its own on this machine."""
-    from domain_coordinator import domain_id
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    os.environ.pop('ROS_LOCALHOST_ONLY', None)
     import nodes
     print('nodes ...', flush=True)
-    with domain_id() as domain:
+    with _own_domain() as domain:
         os.environ['ROS_DOMAIN_ID'] = str(domain)
         lines = nodes.measure(quick)
     header = ['## attitude_simulator as a process', '', f'Measured {machine}.', '',

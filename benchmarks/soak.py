@@ -1,0 +1,83 @@
+"""
+Soak: 1e7 integration steps (1e4 s at 1 kHz) of attitude_simulator with the analyzer watching.
+
+The simulator runs as fast as possible, publishing every 10 ms of simulated
+time; both nodes are processes. Every 10 s of wall time the resident memory
+of both and their diagnostics are sampled: simulated steps, the drift of T,
+|L| and L direction (simulator), the analyzer's conservation status.
+``./dev bench --only soak`` (about 5 minutes).
+"""
+
+import os
+import sys
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray
+from rigid_body_dynamics.nodes.conversions import status_values
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, '..', 'test'))
+from nodes import ANALYZER, Process, sim  # noqa: E402, I100 (after the path set-up)
+from ros_harness import Probe  # noqa: E402
+
+STEPS = 10_000_000
+
+
+def rss_mb(pid):
+    """Resident memory (MB) of a process, from /proc."""
+    with open(f'/proc/{pid}/status') as f:
+        for line in f:
+            if line.startswith('VmRSS:'):
+                return int(line.split()[1]) / 1024.0
+    return float('nan')
+
+
+def _newest(probe, suffix):
+    for array in reversed(probe.messages['/diagnostics']):
+        for st in array.status:
+            if st.name.endswith(suffix):
+                return st, status_values(st)
+    return None, {}
+
+
+def measure(steps=STEPS, period=10.0):
+    """Run the soak; returns Markdown lines."""
+    probe = Probe('soak')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    simulator = Process(sim('real_time_factor:=0.0', 'publish_rate:=100.0'))
+    analyzer = Process(ANALYZER + ['-p', 'window:=10.0'])
+    rows = []
+    start = time.monotonic()
+    try:
+        done = 0
+        while done < steps and time.monotonic() - start < 1800.0:
+            probe.spin_for(period)
+            _, sim_values = _newest(probe, 'integrator')
+            cons, an_values = _newest(probe, 'conservation')
+            if not sim_values:
+                continue
+            done = int(sim_values['steps'])
+            rows.append((time.monotonic() - start, done, rss_mb(simulator.proc.pid),
+                         rss_mb(analyzer.proc.pid),
+                         float(sim_values['energy drift since last torque (rel.)']),
+                         float(sim_values['|L| drift since last torque (rel.)']),
+                         float(sim_values['L direction drift since last torque (rad)']),
+                         cons.message if cons else 'n/a',
+                         an_values.get('energy drift since baseline (rel.)', 'n/a')))
+    finally:
+        analyzer.close()
+        simulator.close()
+        probe.close()
+    lines = ['| wall (s) | steps | simulator RSS (MB) | analyzer RSS (MB) | T drift | |L| drift '
+             '| L direction (rad) | analyzer conservation | analyzer T drift |',
+             '|---|---|---|---|---|---|---|---|---|']
+    keep = rows if len(rows) <= 12 else rows[::max(1, len(rows) // 10)] + [rows[-1]]
+    for r in keep:
+        lines.append(f'| {r[0]:.0f} | {r[1]:.3g} | {r[2]:.1f} | {r[3]:.1f} | {r[4]:.1e} | '
+                     f'{r[5]:.1e} | {r[6]:.1e} | {r[7]} | {r[8]} |')
+    if rows:
+        growth = (rows[-1][2] - rows[len(rows) // 4][2], rows[-1][3] - rows[len(rows) // 4][3])
+        lines += ['', f'{rows[-1][1]:.3g} steps in {rows[-1][0]:.0f} s of wall time. Memory '
+                  f'growth over the last three quarters of the run: simulator '
+                  f'{growth[0]:+.1f} MB, analyzer {growth[1]:+.1f} MB.']
+    return lines
