@@ -79,6 +79,8 @@ def test_symmetric_top_precession_and_conservation(launch, probe):
         'a precession estimate')
     # let the window fill with a few precession periods (10 s of stamps)
     probe.spin_for(3.0)
+    probe.wait_for('precession/body_rate', 1, timeout=20.0)
+    probe.wait_for('kinetic_energy', 1, timeout=20.0)
     level, message, values = newest(probe, 'precession')
     assert float(values['body rate error (rel.)']) < 1e-4
     assert float(values['lab rate error (rel.)']) < 1e-4
@@ -145,6 +147,7 @@ def test_torque_pulses_keep_balance_laws_ok(launch, probe):
     energy = probe.subscribe(Float64, 'kinetic_energy')
     wait_status(probe, 'conservation', lambda v: v.get('mode') == 'free motion', 30.0,
                 'free-motion conservation')
+    probe.wait_for('kinetic_energy', 1, timeout=20.0)   # matched later than /diagnostics, maybe
     e_before = energy[-1].data
     torque = probe.publisher(WrenchStamped, 'torque_cmd')
     for vec in ((0.3, 0.1, 0.5), (-0.2, 0.3, 0.4)):
