@@ -13,7 +13,6 @@ import sys
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from rigid_body_dynamics.nodes.conversions import status_values
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..', 'test'))
@@ -32,14 +31,6 @@ def rss_mb(pid):
     return float('nan')
 
 
-def _newest(probe, suffix):
-    for array in reversed(probe.messages['/diagnostics']):
-        for st in array.status:
-            if st.name.endswith(suffix):
-                return st, status_values(st)
-    return None, {}
-
-
 def measure(steps=STEPS, period=10.0):
     """Run the soak; returns Markdown lines."""
     probe = Probe('soak')
@@ -52,17 +43,18 @@ def measure(steps=STEPS, period=10.0):
         done = 0
         while done < steps and time.monotonic() - start < 1800.0:
             probe.spin_for(period)
-            _, sim_values = _newest(probe, 'integrator')
-            cons, an_values = _newest(probe, 'conservation')
-            if not sim_values:
+            sim_status = probe.newest_status('integrator')
+            cons = probe.newest_status('conservation')
+            if sim_status is None:
                 continue
+            sim_values, an_values = sim_status[2], (cons[2] if cons else {})
             done = int(sim_values['steps'])
             rows.append((time.monotonic() - start, done, rss_mb(simulator.proc.pid),
                          rss_mb(analyzer.proc.pid),
                          float(sim_values['energy drift since last torque (rel.)']),
                          float(sim_values['|L| drift since last torque (rel.)']),
                          float(sim_values['L direction drift since last torque (rad)']),
-                         cons.message if cons else 'n/a',
+                         cons[1] if cons else 'n/a',
                          an_values.get('energy drift since baseline (rel.)', 'n/a')))
     finally:
         analyzer.close()

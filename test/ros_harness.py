@@ -17,6 +17,7 @@ import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rigid_body_dynamics.nodes.conversions import status_values
 
 #: Subscriber QoS for the tests: reliable with a deep queue, so nothing is dropped.
 DEEP = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10000,
@@ -115,6 +116,19 @@ class Probe:
         self.spin_until(future.done, timeout, f'the response of {name}')
         self.node.destroy_client(client)
         return future.result()
+
+    def newest_status(self, name):
+        """
+        Return (level, message, values) of the newest /diagnostics status called ``name``.
+
+        ``name`` is the full status name or its end (e.g. 'torque command');
+        None until one arrived. Needs ``subscribe(DiagnosticArray, '/diagnostics')``.
+        """
+        for array in reversed(self.messages.get('/diagnostics', [])):
+            for status in array.status:
+                if status.name.endswith(name):
+                    return status.level, status.message, status_values(status)
+        return None
 
     def close(self):
         """Tear down node, executor and context."""

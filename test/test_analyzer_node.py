@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from rcl_interfaces.srv import SetParametersAtomically
 from rclpy.parameter import Parameter
-from rigid_body_dynamics.nodes.conversions import quaternion_msg, status_values, time_msg
+from rigid_body_dynamics.nodes.conversions import quaternion_msg, time_msg
 from rigid_body_dynamics.nodes.conversions import vector_msg
 from rigid_body_dynamics.physics import FreeRigidBody, presets, theory
 from std_msgs.msg import Float64
@@ -24,22 +24,13 @@ SIM = 'rigid_body_dynamics.nodes.simulator'
 ANALYZER = 'rigid_body_dynamics.nodes.analyzer'
 
 
-def newest(probe, check):
-    """(level, message, values) of the analyzer's newest status ``check``, or None."""
-    for array in reversed(probe.messages['/diagnostics']):
-        for st in array.status:
-            if st.name == f'attitude_analyzer: {check}':
-                return st.level, st.message, status_values(st)
-    return None
-
-
 def wait_status(probe, check, predicate, timeout, what):
     """Spin until the newest status ``check`` satisfies ``predicate(values)``; return it."""
     def ok():
-        found = newest(probe, check)
+        found = probe.newest_status(f'attitude_analyzer: {check}')
         return found is not None and predicate(found[2])
     probe.spin_until(ok, timeout, what)
-    return newest(probe, check)
+    return probe.newest_status(f'attitude_analyzer: {check}')
 
 
 def is_number(text):
@@ -81,18 +72,18 @@ def test_symmetric_top_precession_and_conservation(launch, probe):
     probe.spin_for(3.0)
     probe.wait_for('precession/body_rate', 1, timeout=20.0)
     probe.wait_for('kinetic_energy', 1, timeout=20.0)
-    level, message, values = newest(probe, 'precession')
+    level, message, values = probe.newest_status('attitude_analyzer: precession')
     assert float(values['body rate error (rel.)']) < 1e-4
     assert float(values['lab rate error (rel.)']) < 1e-4
     assert float(values['body rate, theory (rad/s)']) == pytest.approx(1.0, rel=1e-12)
     assert body_rate and body_rate[-1].data == pytest.approx(1.0, rel=1e-4)
     assert energy[-1].data == pytest.approx(0.5 * (0.09 + 1.5 * 4.0), rel=1e-12)
-    level, message, values = newest(probe, 'conservation')
+    level, message, values = probe.newest_status('attitude_analyzer: conservation')
     assert level == DiagnosticStatus.OK, message
     assert float(values['energy drift since baseline (rel.)']) < 1e-12
-    level, message, values = newest(probe, 'stability')
+    level, message, values = probe.newest_status('attitude_analyzer: stability')
     assert values['class'] == 'stable' and values['nearest principal axis'] == '3'
-    level, message, values = newest(probe, 'input')
+    level, message, values = probe.newest_status('attitude_analyzer: input')
     assert level == DiagnosticStatus.OK and float(values['rate (Hz)']) > 100.0
     assert values['inertia source'] == 'topic'
     stop_cleanly(analyzer, sim)
@@ -197,7 +188,7 @@ def test_broken_physics_turns_conservation_to_error(launch, probe):
     # until the analyzer (baseline at its first analysis, whenever that is) sees the drift
 
     def drift_seen():
-        found = newest(probe, 'conservation')
+        found = probe.newest_status('attitude_analyzer: conservation')
         return found is not None and float(
             found[2].get('energy drift since baseline (rel.)', 0.0)) > 1e-4
     for second in range(40):
@@ -207,7 +198,7 @@ def test_broken_physics_turns_conservation_to_error(launch, probe):
         if drift_seen():
             break
     assert drift_seen(), 'the analyzer never reported the energy drift'
-    level, message, values = newest(probe, 'conservation')
+    level, message, values = probe.newest_status('attitude_analyzer: conservation')
     assert level == DiagnosticStatus.ERROR, message
     assert 'energy' in message
     stop_cleanly(analyzer)
@@ -240,10 +231,10 @@ def test_dropped_duplicated_reordered_and_time_reset(launch, probe, rng):
         probe, 'input', lambda v: int(v.get('restarts after a time reset', 0)) >= 1, 20.0,
         'the reset to be noticed')
     probe.spin_for(1.5)
-    level, message, values = newest(probe, 'precession')
+    level, message, values = probe.newest_status('attitude_analyzer: precession')
     assert float(values['body rate, theory (rad/s)']) == pytest.approx(0.5, rel=1e-12)
     assert float(values['body rate error (rel.)']) < 1e-9
-    level, message, values = newest(probe, 'conservation')
+    level, message, values = probe.newest_status('attitude_analyzer: conservation')
     assert level == DiagnosticStatus.OK
     assert probe.call(Trigger, '/attitude_analyzer/reset_baseline', Trigger.Request()).success
     stop_cleanly(analyzer)
@@ -258,10 +249,10 @@ def test_without_inertia_nothing_is_made_up(launch, probe):
     body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
     _publish_states(probe, pub, np.arange(0.0, 3.0, 0.01), body)
     probe.spin_for(2.5)
-    level, message, values = newest(probe, 'precession')
+    level, message, values = probe.newest_status('attitude_analyzer: precession')
     assert 'no inertia' in message and level == DiagnosticStatus.WARN
     assert not rates and not energy
-    level, message, values = newest(probe, 'input')
+    level, message, values = probe.newest_status('attitude_analyzer: input')
     assert values['inertia source'] == 'none'
     # parameters are validated with a reason, then applied
     refused = set_params(probe, inertia=[1.0, 1.0, 3.0])
@@ -273,7 +264,7 @@ def test_without_inertia_nothing_is_made_up(launch, probe):
     level, message, values = wait_status(
         probe, 'precession', lambda v: 'body rate error (rel.)' in v, 20.0, 'estimates')
     assert float(values['body rate error (rel.)']) < 1e-9
-    assert newest(probe, 'input')[2]['inertia source'] == 'parameter'
+    assert probe.newest_status('attitude_analyzer: input')[2]['inertia source'] == 'parameter'
     stop_cleanly(analyzer)
 
 

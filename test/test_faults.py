@@ -14,17 +14,8 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 import pytest
-from rigid_body_dynamics.nodes.conversions import status_values
 
 SCRIPTS = os.path.join(sys.prefix, 'lib', 'rigid_body_dynamics')
-
-
-def newest(probe, check):
-    for array in reversed(probe.messages['/diagnostics']):
-        for st in array.status:
-            if st.name == f'attitude_analyzer: {check}':
-                return st.level, st.message, status_values(st)
-    return None
 
 
 @pytest.mark.skipif(not os.path.exists(os.path.join(SCRIPTS, 'attitude_simulator')),
@@ -54,7 +45,7 @@ def test_analyzer_crash_and_simulator_restart(launch, probe, monkeypatch):
     probe.subscribe(DiagnosticArray, '/diagnostics')
 
     def good_estimate():
-        found = newest(probe, 'precession')
+        found = probe.newest_status('attitude_analyzer: precession')
         return found is not None and 'body rate error (rel.)' in found[2] and \
             float(found[2]['body rate error (rel.)']) < 1e-6
     probe.spin_until(good_estimate, 40.0, 'estimates')
@@ -64,18 +55,21 @@ def test_analyzer_crash_and_simulator_restart(launch, probe, monkeypatch):
     analyzer = launch('rigid_body_dynamics.nodes.analyzer', '-p', 'window:=4.0',
                       name='analyzer2')
     probe.spin_until(good_estimate, 40.0, 'estimates from the restarted analyzer')
-    assert newest(probe, 'input')[2]['inertia source'] == 'topic'   # latched inertia re-read
+    # the latched inertia was read again
+    assert probe.newest_status('attitude_analyzer: input')[2]['inertia source'] == 'topic'
     # now the simulator restarts under the running analyzer: its stamps go back to 0
     code, _ = sim.stop()
     assert code == 0
     sim = launch('rigid_body_dynamics.nodes.simulator', '-p', 'publish_clock:=true',
                  '-p', 'real_time_factor:=4.0', name='sim2')
-    probe.spin_until(lambda: newest(probe, 'input') is not None and int(
-        newest(probe, 'input')[2]['restarts after a time reset']) >= 1, 40.0,
-        'the time reset to be detected')
+
+    def resets():
+        found = probe.newest_status('attitude_analyzer: input')
+        return int(found[2]['restarts after a time reset']) if found else 0
+    probe.spin_until(lambda: resets() >= 1, 40.0, 'the time reset to be detected')
     probe.messages['/diagnostics'].clear()
     probe.spin_until(good_estimate, 40.0, 'estimates after the simulator restart')
-    level, _, _ = newest(probe, 'conservation')
+    level, _, _ = probe.newest_status('attitude_analyzer: conservation')
     assert level == DiagnosticStatus.OK
     for proc in (analyzer, sim):
         code, _ = proc.stop()

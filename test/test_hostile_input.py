@@ -15,7 +15,7 @@ from nav_msgs.msg import Odometry
 import numpy as np
 from rcl_interfaces.srv import SetParameters
 from rclpy.parameter import Parameter
-from rigid_body_dynamics.nodes.conversions import quaternion_array, status_values, time_msg
+from rigid_body_dynamics.nodes.conversions import quaternion_array, time_msg
 from rigid_body_dynamics.nodes.conversions import vector_array
 from rigid_body_dynamics.physics import FreeRigidBody, quaternions
 from std_srvs.srv import SetBool, Trigger
@@ -28,14 +28,6 @@ BAD_FRAMES = ['map', 'x' * 100000, 'base_link ', '/odom', 'ödom', '\t']
 
 def stamp(msg):
     return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
-
-
-def newest(probe, suffix):
-    for array in reversed(probe.messages['/diagnostics']):
-        for st_ in array.status:
-            if st_.name.endswith(suffix):
-                return st_.level, st_.message, status_values(st_)
-    return None
 
 
 def assert_free_motion(odom, moments=(1.0, 1.0, 1.5), omega0=(0.3, 0.0, 2.0)):
@@ -96,7 +88,7 @@ def test_torque_flood_of_garbage_changes_nothing(launch, probe):
     # commands are "latest wins": a flood overflows the subscriber's queue (depth 10) by
     # design, so only the ones that arrived are counted, and none of them was accepted
     probe.spin_for(2.5)
-    _, _, values = newest(probe, 'torque command')
+    _, _, values = probe.newest_status('torque command')
     rejected = int(values['rejected_non_finite']) + int(values['rejected_frame'])
     assert 0 < rejected <= len(sent)
     assert values['accepted'] == '0'
@@ -118,8 +110,8 @@ def test_huge_and_denormal_torques_are_clipped_or_taken_exactly(launch, probe):
         pub.publish(msg)
         probe.spin_until(lambda: applied[-1].wrench.torque.z == min(value, 1.0), 10.0,
                          f'torque {value!r} to be applied')
-    probe.spin_until(lambda: newest(probe, 'torque command') is not None
-                     and newest(probe, 'torque command')[2]['clipped'] == '1', 10.0, 'clip')
+    probe.spin_until(lambda: probe.newest_status('torque command') is not None
+                     and probe.newest_status('torque command')[2]['clipped'] == '1', 10.0, 'clip')
     assert proc.proc.poll() is None
     code, _ = proc.stop()
     assert code == 0
@@ -172,9 +164,9 @@ def test_analyzer_survives_hostile_odom(launch, probe):
             probe.spin_for(0.005)
     probe.spin_for(2.5)
     # best effort: some samples may be lost in the burst, so the count is bounded
-    _, _, values = newest(probe, 'input')
+    _, _, values = probe.newest_status('input')
     assert 0 < int(values['dropped non-finite samples']) <= bad
-    _, _, values = newest(probe, 'precession')
+    _, _, values = probe.newest_status('precession')
     assert float(values['body rate error (rel.)']) < 1e-9   # the good samples still agree
     for far in (4e9, 0.0):                                  # a far-future stamp, then the past
         msg = Odometry()
@@ -183,7 +175,7 @@ def test_analyzer_survives_hostile_odom(launch, probe):
         msg.twist.twist.angular.z = 1.0
         pub.publish(msg)
         probe.spin_for(1.5)
-    _, _, values = newest(probe, 'input')
+    _, _, values = probe.newest_status('input')
     assert int(values['restarts after a gap']) >= 1
     assert int(values['restarts after a time reset']) >= 1
     assert analyzer.proc.poll() is None

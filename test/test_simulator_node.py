@@ -16,7 +16,7 @@ import pytest
 from rcl_interfaces.srv import SetParameters
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
-from rigid_body_dynamics.nodes.conversions import quaternion_array, status_values, vector_array
+from rigid_body_dynamics.nodes.conversions import quaternion_array, vector_array
 from rigid_body_dynamics.physics import FreeRigidBody, Inertia, quaternions
 from ros_harness import LATCHED
 from rosgraph_msgs.msg import Clock
@@ -67,15 +67,6 @@ def stop_cleanly(proc):
     assert 'Traceback' not in proc.output()
 
 
-def latest_status(probe, suffix):
-    """Key -> value of the newest diagnostic status whose name ends with ``suffix``."""
-    for array in reversed(probe.messages['/diagnostics']):
-        for st in array.status:
-            if st.name.endswith(suffix):
-                return st, status_values(st)
-    return None, {}
-
-
 def test_torque_free_motion_is_exact_and_bad_input_changes_nothing(launch, probe):
     """Default integrator, 10 s simulated; NaN / inf / unknown-frame torques and bad parameters."""
     proc = launch(SIM, '-p', 'publish_clock:=true', '-p', 'real_time_factor:=2.0', name='sim')
@@ -122,12 +113,12 @@ def test_torque_free_motion_is_exact_and_bad_input_changes_nothing(launch, probe
     assert np.max(np.abs(np.linalg.norm(lw, axis=1) / np.linalg.norm(lw[0]) - 1.0)) <= 1e-10
     angles = np.arctan2(np.linalg.norm(np.cross(lw, lw[0]), axis=1), lw @ lw[0])
     assert np.max(angles) <= 1e-10
-    probe.spin_until(lambda: latest_status(probe, 'torque command')[1].get(
+    probe.spin_until(lambda: (probe.newest_status('torque command') or (0, '', {}))[2].get(
         'rejected_frame') == '2', 10.0, 'rejections counted in diagnostics')
-    status, values = latest_status(probe, 'torque command')
+    _, message, values = probe.newest_status('torque command')
     assert values['rejected_non_finite'] == '3'
     assert values['accepted'] == '0'
-    assert 'rejected' in status.message
+    assert 'rejected' in message
     stop_cleanly(proc)
 
 
@@ -297,7 +288,7 @@ def test_as_fast_as_possible_still_serves_services_and_diagnostics(launch, probe
     proc = launch(SIM, '-p', 'real_time_factor:=0.0', '-p', 'publish_rate:=1.0', name='sim')
     probe.subscribe(DiagnosticArray, '/diagnostics')
     probe.wait_for('/diagnostics', 2, timeout=20.0)
-    _, values = latest_status(probe, 'integrator')
+    _, _, values = probe.newest_status('integrator')
     assert float(values['achieved real-time factor']) > 5.0
     assert probe.call(Trigger, f'{NODE}/reset', Trigger.Request(), timeout=10.0).success
     assert set_params(probe, max_torque=2.0)[0].successful
