@@ -5,7 +5,8 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 ``--peers`` adds MuJoCo and Basilisk if installed
 (``.venv/bin/pip install -r benchmarks/requirements-peers.txt``);
 ``--nodes`` measures the simulator node as a process (CPU, rates, latency);
-``--only nodes`` skips the physics sections.
+``--only nodes`` skips the physics sections; ``--only soak | soak-rt | flood |
+bodies | hosts`` runs one reliability / scale measurement (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
 run now are replaced.
@@ -42,14 +43,17 @@ def main():
     parser.add_argument('--quick', action='store_true', help='1e5 steps instead of 1e6')
     parser.add_argument('--peers', action='store_true', help='also MuJoCo and Basilisk')
     parser.add_argument('--nodes', action='store_true', help='also the simulator node')
-    parser.add_argument('--only', choices=['nodes', 'soak'], help='run only this section')
+    parser.add_argument('--only', choices=['nodes', 'soak', 'soak-rt', 'flood', 'bodies',
+                                           'hosts'], help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
     machine = common.machine()
     sections = {}
 
-    if args.only == 'soak':
-        soak_section(sections, machine)
+    if args.only in ('soak', 'soak-rt'):
+        soak_section(sections, machine, real_time=args.only == 'soak-rt')
+    elif args.only in SCALE:
+        scale_section(sections, machine, args.only)
     else:
         if args.only == 'nodes':
             args.nodes = True
@@ -68,16 +72,43 @@ def _own_domain():
     return domain_id()
 
 
-def soak_section(sections, machine):
-    """Soak both nodes for 1e7 steps and record memory and drift."""
+def soak_section(sections, machine, real_time=False):
+    """Soak both nodes for 1e7 steps and record memory, drift and missed deadlines."""
     import soak
-    print('soak (about 5 minutes) ...', flush=True)
+    print(f'soak (about {17 if real_time else 5} minutes) ...', flush=True)
     with _own_domain() as domain:
         os.environ['ROS_DOMAIN_ID'] = str(domain)
-        lines = soak.measure()
+        lines = soak.measure(real_time=real_time)
+    if real_time:
+        header = ['## Soak in real time: 1e7 steps at 10 kHz with both nodes', '',
+                  f'Measured {machine}; see the soak section above for the set-up.', '']
+        sections['soak-rt'] = '\n'.join(header + lines)
+        return
     header = ['## Soak: 1e7 steps with both nodes', '', f'Measured {machine}.', '',
               soak.__doc__.strip().replace('\n', ' '), '']
     sections['soak'] = '\n'.join(header + lines)
+
+
+#: Sections measured by one script each: name -> (module, heading).
+SCALE = {
+    'flood': ('flood', 'Torque-command flood: 10 kHz for 10 s'),
+    'bodies': ('bodies', 'Many bodies on one machine'),
+    'hosts': ('hosts', 'Several hosts: network namespaces on one machine'),
+}
+
+
+def scale_section(sections, machine, name):
+    """Run one of the reliability / scale scripts in a DDS domain of its own."""
+    import importlib
+    module_name, heading = SCALE[name]
+    module = importlib.import_module(module_name)
+    print(f'{name} ...', flush=True)
+    with _own_domain() as domain:
+        os.environ['ROS_DOMAIN_ID'] = str(domain)
+        lines = module.measure()
+    header = [f'## {heading}', '', f'Measured {machine}.', '',
+              module.__doc__.strip().replace('\n', ' '), '']
+    sections[name] = '\n'.join(header + lines)
 
 
 def node_section(sections, machine, quick):
