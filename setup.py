@@ -29,6 +29,7 @@ setup(
             'attitude_simulator = rigid_body_dynamics.nodes.entry:simulator',
             'attitude_analyzer = rigid_body_dynamics.nodes.entry:analyzer',
             'poinsot_visualizer = rigid_body_dynamics.nodes.entry:poinsot',
+            'attitude_fleet = rigid_body_dynamics.nodes.entry:fleet',
             'rigid_body_report = rigid_body_dynamics.report:main',
         ],
     },

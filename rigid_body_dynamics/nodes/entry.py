@@ -39,3 +39,10 @@ def poinsot():
     early = _guard()
     from .poinsot import main
     return main(early=early)
+
+
+def fleet():
+    """Entry point of attitude_fleet."""
+    early = _guard()
+    from .fleet import main
+    return main(early=early)

@@ -26,6 +26,8 @@ def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
     """
     Create the node with ``make_node()`` and spin it until SIGINT / SIGTERM.
 
+    ``make_node()`` may also return an object whose ``nodes`` attribute lists
+    several nodes (attitude_fleet); one executor then serves them all.
     ``on_start(node)`` / ``on_stop(node)`` run after creation / before
     destruction. ``early``: signals already received by an entry point (see
     ``entry.py``); if any, the node stops at once. Returns the process exit
@@ -47,7 +49,8 @@ def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
         if on_start and not stop.is_set():
             on_start(node)
         executor = SingleThreadedExecutor()
-        executor.add_node(node)
+        for each in getattr(node, 'nodes', [node]):
+            executor.add_node(each)
         while not stop.is_set() and rclpy.ok():
             executor.spin_once(timeout_sec=SLICE)
     except (KeyboardInterrupt, ExternalShutdownException):
@@ -60,7 +63,8 @@ def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
         if node is not None:
             if on_stop:
                 on_stop(node)
-            node.destroy_node()
+            for each in getattr(node, 'nodes', [node]):
+                each.destroy_node()
         rclpy.try_shutdown()
         for sig, handler in previous.items():
             signal.signal(sig, handler)

@@ -410,7 +410,19 @@ class AttitudeSimulator(Node):
                 raise
 
     def _cycle(self):
-        """Integrate the steps that are due (or a batch, as fast as possible), else sleep."""
+        """Integrate and publish the steps that are due, then sleep until the next is due."""
+        wait = self.step_due()
+        if wait > 0.0:
+            self._stop.wait(wait)
+
+    def step_due(self):
+        """
+        Integrate the steps that are due now (a batch, as fast as possible) and publish.
+
+        Returns the wall time (s) until the next step is due. Called by this
+        node's integration thread, or by one thread that steps many bodies
+        (attitude_fleet) instead of ``start()``.
+        """
         outbox = []
         with self._lock:
             if self._paused:
@@ -445,8 +457,7 @@ class AttitudeSimulator(Node):
         # publish outside the lock: a torque command never waits for publishing
         for snapshot in outbox:
             self._publish_state(snapshot)
-        if wait > 0.0:
-            self._stop.wait(wait)
+        return wait
 
     def _advance(self, now_ns, outbox):
         """One integration step; on a publish tick its state goes into ``outbox``."""

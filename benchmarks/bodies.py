@@ -1,0 +1,104 @@
+"""
+Many bodies on one machine: how many run in real time at 1 kHz integration and 100 Hz publishing.
+
+Three ways, all with the defaults of the symmetric top (exact integrator, 7
+state topics per body): one ``attitude_simulator`` process per body (a
+namespace each), one ``attitude_fleet`` process whose bodies share one
+integration thread, and one ``attitude_fleet`` process with an integration
+thread per body. For each count N the bodies start, run until every one has
+reported, and then for a window the CPU of all processes is summed and every
+body's diagnostics are read. N runs in real time when every body achieved a
+real-time factor of at least 0.99 and at most 2 steps of all bodies together
+were more than 5 ms late in the window. Each sweep ends after two failures in
+a row. ``./dev bench --only bodies`` (about 15 minutes).
+"""
+
+import os
+import sys
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, '..', 'test'))
+from nodes import cpu_seconds, MAX_MISSED, Process, sim  # noqa: E402, I100 (after the path set-up)
+from rigid_body_dynamics.nodes.conversions import status_values  # noqa: E402
+from ros_harness import Probe  # noqa: E402
+
+FLEET = [sys.executable, '-m', 'rigid_body_dynamics.nodes.fleet']
+COUNTS = (1, 2, 4, 8, 12, 16, 24, 32, 48, 64)
+MISSED = 'missed deadlines (> 5 ms late)'
+
+
+def commands(way, n):
+    """Process command lines that run ``n`` bodies ``way``."""
+    if way == 'processes':
+        return [sim() + ['-r', f'__ns:=/body{k}'] for k in range(1, n + 1)]
+    threads = 'shared' if way == 'fleet, shared thread' else 'per-body'
+    return [FLEET + ['--bodies', str(n), '--threads', threads, '--ros-args']]
+
+
+def integrator_statuses(probe, since=0):
+    """{body's node name: [status values, oldest first]} of the diagnostics since index ``since``."""
+    found = {}
+    for array in probe.messages['/diagnostics'][since:]:
+        for status in array.status:
+            if status.name.endswith(': integrator'):
+                found.setdefault(status.hardware_id, []).append(status_values(status))
+    return found
+
+
+def run_bodies(probe, way, n, window):
+    """Run ``n`` bodies; returns (CPU in cores, missed, slowest real-time factor, reason)."""
+    diags = probe.messages['/diagnostics']
+    diags.clear()
+    procs = [Process(c) for c in commands(way, n)]
+    try:
+        deadline = time.monotonic() + 30.0 + 2.0 * n
+        while len(integrator_statuses(probe)) < n and time.monotonic() < deadline:
+            probe.spin_for(0.5)
+        if len(integrator_statuses(probe)) < n:
+            return float('nan'), 0, 0.0, f'only {len(integrator_statuses(probe))} reported'
+        probe.spin_for(3.0)
+        first = len(diags)
+        pids = [p.proc.pid for p in procs]
+        c0, t0 = sum(cpu_seconds(p) for p in pids), time.monotonic()
+        probe.spin_for(window)
+        cpu = (sum(cpu_seconds(p) for p in pids) - c0) / (time.monotonic() - t0)
+        seen = integrator_statuses(probe, max(first - 1, 0))
+        missed = sum(int(v[-1][MISSED]) - int(v[0][MISSED]) for v in seen.values())
+        slowest = min(float(v[-1]['achieved real-time factor']) for v in seen.values())
+        return cpu, missed, slowest, '' if len(seen) == n else f'{len(seen)} of {n} reported'
+    finally:
+        for p in procs:
+            p.close()
+
+
+def measure(window=8.0, counts=COUNTS):
+    """Sweep the body count for each way; returns Markdown lines."""
+    probe = Probe('bench_bodies')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    lines = ['| way | bodies | CPU (cores) | CPU per body (% of a core) | missed deadlines '
+             '(all bodies) | slowest achieved real-time factor | real time |',
+             '|---|---|---|---|---|---|---|']
+    best = {}
+    try:
+        for way in ('processes', 'fleet, shared thread', 'fleet, thread per body'):
+            failures = 0
+            for n in counts:
+                cpu, missed, slowest, why = run_bodies(probe, way, n, window)
+                ok = not why and missed <= MAX_MISSED and slowest >= 0.99
+                lines.append(f'| {way} | {n} | {cpu:.2f} | {100 * cpu / n:.1f} | {missed} | '
+                             f'{slowest:.3f} | {"yes" if ok else "no"}{", " + why if why else ""}'
+                             ' |')
+                print(lines[-1], flush=True)
+                if ok:
+                    best[way] = n
+                failures = 0 if ok else failures + 1
+                if failures == 2:
+                    break
+    finally:
+        probe.close()
+    summary = ', '.join(f'{way}: {best.get(way, 0)}' for way in
+                        ('processes', 'fleet, shared thread', 'fleet, thread per body'))
+    return lines + ['', f'Most bodies in real time: {summary}.']

@@ -1,0 +1,148 @@
+"""
+Torque-command flood: 10 kHz for 10 s at attitude_simulator (defaults: 1 kHz, 100 Hz, real time).
+
+A separate flooder process publishes torque_cmd in bursts of 10 every
+millisecond (10 kHz on average) for 10 s: valid body torques of 1e-6 N m,
+non-finite torques, or an unknown frame_id. Measured during the flood: the
+rate actually sent, the commands the simulator took (accepted + rejected
+counters in its diagnostics), its achieved real-time factor and missed
+deadlines, odom received by a subscriber, the simulator's CPU; for the
+rejected classes also the largest deviation of the published state from the
+exact free motion (the run that never saw the flood). ``./dev bench --only
+flood`` (about 2 minutes).
+"""
+
+import os
+import sys
+import textwrap
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray
+from nav_msgs.msg import Odometry
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, '..', 'test'))
+from nodes import cpu_seconds, Process, script, sim  # noqa: E402, I100 (after the path set-up)
+from rigid_body_dynamics.nodes.conversions import quaternion_array  # noqa: E402
+from rigid_body_dynamics.nodes.conversions import vector_array  # noqa: E402
+from rigid_body_dynamics.physics import FreeRigidBody, presets, quaternions  # noqa: E402
+from ros_harness import Probe  # noqa: E402
+
+RATE = 10_000
+SECONDS = 10.0
+FLOODER = textwrap.dedent("""
+    import math, sys, time
+    import rclpy
+    from geometry_msgs.msg import WrenchStamped
+    kind, rate, seconds = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
+    rclpy.init()
+    node = rclpy.create_node('flooder')
+    pub = node.create_publisher(WrenchStamped, 'torque_cmd', 10)
+    end = time.monotonic() + 20.0
+    while pub.get_subscription_count() < 1 and time.monotonic() < end:
+        time.sleep(0.05)
+    time.sleep(1.0)
+    msg = WrenchStamped()
+    if kind == 'non-finite torque':
+        msg.wrench.torque.x = math.nan
+    elif kind == 'unknown frame_id':
+        msg.header.frame_id = 'map'
+    else:
+        msg.wrench.torque.x = 1e-6
+    burst, n = 10, int(rate * seconds)
+    period = burst / rate
+    start = time.perf_counter()
+    sent = 0
+    print('start', flush=True)
+    while sent < n:
+        wait = start + (sent // burst) * period - time.perf_counter()
+        if wait > 0:
+            time.sleep(wait)
+        for _ in range(burst):
+            pub.publish(msg)
+        sent += burst
+    print('sent', sent, time.perf_counter() - start, flush=True)
+    node.destroy_node()
+    rclpy.shutdown()
+""")
+KINDS = ('valid body torque', 'non-finite torque', 'unknown frame_id')
+COUNTERS = ('accepted', 'rejected_non_finite', 'rejected_frame')
+
+
+def stamp(msg):
+    """Header stamp of a message (s)."""
+    return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+
+
+def deviation(odom):
+    """Largest attitude (rad) and angular-velocity (rad/s) error against the exact free motion."""
+    body = presets.get(presets.DEFAULT)
+    t = np.array([stamp(m) for m in odom])
+    q = np.array([quaternion_array(m.pose.pose.orientation) for m in odom])
+    w = np.array([vector_array(m.twist.twist.angular) for m in odom])
+    q_ref, w_ref = FreeRigidBody(body.moments, body.omega0, body.q0).state_at(t)
+    return (float(np.max(quaternions.angle_between(q, q_ref))),
+            float(np.max(np.abs(w - w_ref))))
+
+
+def flood(probe, kind):
+    """One flood; returns a row of measurements."""
+    probe.messages['/diagnostics'].clear()
+    odom = probe.messages['odom']
+    odom.clear()
+    simulator = Process(sim('publish_clock:=true'))
+    flooder = Process(script(FLOODER) + [kind, str(RATE), str(SECONDS)])
+    try:
+        def started():
+            flooder.log.seek(0)
+            return b'start' in flooder.log.read()
+        probe.spin_until(started, 40.0, 'the flooder')
+        before = probe.newest_status('torque command')
+        integ0 = probe.newest_status('integrator')
+        n0 = len(odom)
+        c0, t0 = cpu_seconds(simulator.proc.pid), time.monotonic()
+        probe.spin_until(lambda: flooder.proc.poll() is not None, SECONDS + 30.0, 'the flood')
+        cpu = (cpu_seconds(simulator.proc.pid) - c0) / (time.monotonic() - t0)
+        odom_rate = (len(odom) - n0) / (time.monotonic() - t0)
+        probe.spin_for(2.5)
+        after = probe.newest_status('torque command')
+        integ1 = probe.newest_status('integrator')
+        flooder.log.seek(0)
+        sent_line = [ln for ln in flooder.log.read().decode().splitlines()
+                     if ln.startswith('sent')][-1].split()
+        sent, elapsed = int(sent_line[1]), float(sent_line[2])
+        took = sum(int(after[2][c]) - int(before[2][c] if before else 0) for c in COUNTERS)
+        missed_key = next(k for k in integ1[2] if k.startswith('missed deadlines'))
+        missed = int(integ1[2][missed_key]) - int(integ0[2][missed_key])
+        achieved = float(integ1[2]['achieved real-time factor'])
+        error = deviation(odom[n0:]) if kind != 'valid body torque' else None
+        alive = simulator.proc.poll() is None
+    finally:
+        flooder.close()
+        simulator.close()
+    return (kind, sent / elapsed, took, took / sent, missed, achieved, odom_rate, cpu, error,
+            alive)
+
+
+def measure():
+    """All flood classes; returns Markdown lines."""
+    probe = Probe('bench_flood')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    probe.subscribe(Odometry, 'odom')
+    lines = ['| flood | sent (Hz) | commands taken by the simulator | fraction taken | '
+             'missed deadlines | achieved real-time factor | odom received (Hz) | simulator '
+             'CPU (% of a core) | state vs exact free motion (rad, rad/s) | still up |',
+             '|---|---|---|---|---|---|---|---|---|---|']
+    try:
+        for kind in KINDS:
+            r = flood(probe, kind)
+            error = 'n/a (torque applied)' if r[8] is None else f'{r[8][0]:.1e}, {r[8][1]:.1e}'
+            lines.append(f'| {r[0]} | {r[1]:.0f} | {r[2]} | {r[3]:.2f} | {r[4]} | {r[5]:.3f} | '
+                         f'{r[6]:.0f} | {100 * r[7]:.0f} | {error} | {"yes" if r[9] else "no"} |')
+            print(lines[-1], flush=True)
+    finally:
+        probe.close()
+    return lines + ['', 'Commands are "latest wins" (a subscriber queue of 10): what the '
+                    'simulator does not take is overwritten in the queue by a newer command, '
+                    'by design; every command taken is counted as accepted or rejected.']

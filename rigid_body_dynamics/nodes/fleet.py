@@ -1,0 +1,125 @@
+"""
+attitude_fleet: many bodies in one process, each a full attitude_simulator in its own namespace.
+
+Every body is an ``AttitudeSimulator`` node named ``attitude_simulator`` in
+namespace ``/<name>``, so its topics, services, parameters and diagnostics are
+exactly those of a separate ``ros2 run rigid_body_dynamics attitude_simulator
+--ros-args -r __ns:=/<name>``: a controller cannot tell the difference.
+Parameters given with ``--ros-args -p`` apply to every body; a parameters
+file can set one body (key ``/<name>/attitude_simulator``) or all
+(``/**/attitude_simulator``).
+
+What the process saves: one interpreter and one DDS participant for all
+bodies, and (by default) one integration thread that steps every body in
+turn and sleeps until the earliest next deadline, instead of one thread per
+body waking at the integration rate (``--threads per-body`` keeps those, for
+comparison; benchmarks/bodies.py measures both against separate processes).
+
+``attitude_fleet [--bodies N] [--prefix body] [--names a,b,...] [--threads
+shared|per-body] [--ros-args ...]``
+"""
+
+import argparse
+import math
+import sys
+import threading
+
+import rclpy
+from rclpy.utilities import remove_ros_args
+
+from .parameters import ConfigurationError
+from .runner import run
+from .simulator import AttitudeSimulator, NODE_NAME
+
+
+def body_names(bodies, prefix, names):
+    """Namespaces of the bodies: ``names`` (comma-separated) or prefix1 ... prefixN."""
+    if names:
+        out = [n.strip().strip('/') for n in names.split(',')]
+    else:
+        out = [f'{prefix}{k}' for k in range(1, bodies + 1)]
+    if not out or any(not n for n in out):
+        raise ConfigurationError(f'no valid body names in {names!r}')
+    if len(set(out)) != len(out):
+        raise ConfigurationError(f'body names must be unique: {out}')
+    return out
+
+
+class Fleet:
+    """The bodies of one process and the thread that steps them (``shared``) or theirs."""
+
+    def __init__(self, names, shared=True, **kwargs):
+        self.nodes = []
+        self.shared = shared
+        self._stop = threading.Event()
+        self._thread = None
+        try:
+            for name in names:
+                self.nodes.append(AttitudeSimulator(namespace='/' + name, **kwargs))
+        except Exception:
+            for node in self.nodes:
+                node.destroy_node()
+            raise
+        self.nodes[0].get_logger().info(
+            f'{len(self.nodes)} bodies in this process ({", ".join(names[:5])}'
+            f'{", ..." if len(names) > 5 else ""}), '
+            f'{"one shared integration thread" if shared else "one integration thread each"}')
+
+    def start(self):
+        """Start stepping the bodies."""
+        if not self.shared:
+            for node in self.nodes:
+                node.start()
+            return
+        self._thread = threading.Thread(target=self._run, name='fleet integration', daemon=True)
+        self._thread.start()
+
+    def stop(self):
+        """Stop the integration thread(s) and wait for them."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=5.0)
+        for node in self.nodes:
+            node.stop()
+
+    def _run(self):
+        try:
+            while not self._stop.is_set():
+                wait = math.inf
+                for node in self.nodes:
+                    wait = min(wait, node.step_due())
+                if wait > 0.0:
+                    self._stop.wait(min(wait, 0.05))
+        except Exception as err:  # a publisher closed under us at shutdown ends the loop
+            if rclpy.ok(context=self.nodes[0].context) and not self._stop.is_set():
+                self.nodes[0].get_logger().error(f'fleet integration thread stopped: {err!r}')
+                raise
+
+
+def main(args=None, early=None):
+    """Run the fleet until Ctrl-C / SIGTERM; exit 0, or 1 (2 for bad options) on bad input."""
+    argv = sys.argv if args is None else args
+    parser = argparse.ArgumentParser(
+        prog='attitude_fleet',
+        description='Many attitude_simulator bodies in one process, one namespace each.')
+    parser.add_argument('--bodies', type=int, default=4,
+                        help='number of bodies, named <prefix>1 ... <prefix>N (default 4)')
+    parser.add_argument('--prefix', default='body', help='namespace prefix (default body)')
+    parser.add_argument('--names', default='',
+                        help='comma-separated namespaces instead of --bodies/--prefix')
+    parser.add_argument('--threads', choices=['shared', 'per-body'], default='shared',
+                        help='one integration thread for all bodies (default) or one each')
+    options = parser.parse_args(remove_ros_args(argv)[1:])
+    if options.bodies < 1 and not options.names:
+        parser.error('--bodies must be at least 1')
+    try:
+        names = body_names(options.bodies, options.prefix, options.names)
+    except ConfigurationError as err:
+        parser.error(str(err))
+    return run(lambda: Fleet(names, shared=options.threads == 'shared'), NODE_NAME, argv,
+               early=early, on_start=lambda fleet: fleet.start(),
+               on_stop=lambda fleet: fleet.stop())
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,102 @@
+"""
+attitude_fleet over real topics: several bodies in one process, each behind its own namespace.
+
+Each body must behave exactly like a separate attitude_simulator: its own
+preset from a parameters file, the exact free motion at its stamps, its own
+torque commands and services, and a clean exit of the whole process.
+"""
+
+from geometry_msgs.msg import InertiaStamped, WrenchStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+import pytest
+from rigid_body_dynamics.physics import presets
+from ros_harness import LATCHED
+from std_srvs.srv import SetBool
+from test_simulator_node import assert_exact, stamp, stop_cleanly
+
+FLEET = 'rigid_body_dynamics.nodes.fleet'
+PARAMS = """\
+/**/attitude_simulator:
+  ros__parameters:
+    publish_rate: 50.0
+/body2/attitude_simulator:
+  ros__parameters:
+    preset: tennis_racket
+    integrator: rk4
+"""
+
+
+def nanoseconds(msg):
+    """Header stamp in integer nanoseconds (a float of seconds since 1970 keeps only 0.2 us)."""
+    return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+
+
+def relative(msgs, start_ns):
+    """Odometry messages with stamps made relative to the body's start (its inertia stamp)."""
+    out = []
+    for m in msgs:
+        copy = Odometry()
+        copy.pose, copy.twist = m.pose, m.twist
+        copy.header.stamp.sec, copy.header.stamp.nanosec = divmod(nanoseconds(m) - start_ns,
+                                                                  1_000_000_000)
+        out.append(copy)
+    return out
+
+
+@pytest.mark.parametrize('threads', ['shared', 'per-body'])
+def test_three_bodies_in_one_process(launch, probe, tmp_path, threads):
+    """Per-body presets, exact motion, torque and pause on one body only, clean exit."""
+    params = tmp_path / 'fleet.yaml'
+    params.write_text(PARAMS)
+    proc = launch(FLEET, '--params-file', str(params), '--', '--bodies', '3',
+                  '--threads', threads, name=f'fleet_{threads}')
+    odom = {k: probe.subscribe(Odometry, f'/body{k}/odom') for k in (1, 2, 3)}
+    inertia = {k: probe.subscribe(InertiaStamped, f'/body{k}/inertia', LATCHED)
+               for k in (1, 2, 3)}
+    for k in (1, 2, 3):
+        probe.wait_for(f'/body{k}/odom', 20, timeout=30.0)
+        probe.wait_for(f'/body{k}/inertia', 1)
+    start = {k: nanoseconds(inertia[k][0]) for k in (1, 2, 3)}
+    rates = {k: (len(odom[k]) - 1) / (stamp(odom[k][-1]) - stamp(odom[k][0])) for k in odom}
+    assert all(r == pytest.approx(50.0, rel=1e-6) for r in rates.values())  # 20 ms apart
+    top, racket = presets.get('symmetric_top'), presets.get('tennis_racket')
+    assert inertia[2][0].inertia.izz == racket.moments[2]
+    assert_exact(relative(odom[1], start[1]), top.moments, top.omega0, top.q0)
+    # rk4 at 1 kHz for a second: about 1e-10 from the exact motion
+    assert_exact(relative(odom[2], start[2]), racket.moments, racket.omega0, racket.q0,
+                 tol=1e-7)
+
+    # a torque on body 3 changes body 3 only
+    applied = probe.subscribe(WrenchStamped, '/body3/applied_torque')
+    pub = probe.publisher(WrenchStamped, '/body3/torque_cmd')
+    command = WrenchStamped()
+    command.wrench.torque.z = 0.5
+    n1 = len(odom[1])
+    pub.publish(command)
+    probe.spin_until(lambda: applied and applied[-1].wrench.torque.z == 0.5, 10.0,
+                     'the torque on body 3')
+    probe.spin_for(0.3)
+    w3 = np.array([[m.twist.twist.angular.z] for m in odom[3][-5:]])
+    assert np.all(w3 > top.omega0[2] + 1e-3)           # spun up about its axis
+    assert_exact(relative(odom[1], start[1]), top.moments, top.omega0, top.q0)
+    assert len(odom[1]) > n1
+
+    # pausing body 2 leaves the others running
+    paused = probe.call(SetBool, '/body2/attitude_simulator/pause', SetBool.Request(data=True))
+    assert paused.success
+    probe.spin_for(0.3)
+    n2, n1 = len(odom[2]), len(odom[1])
+    probe.spin_for(0.5)
+    assert len(odom[2]) == n2 and len(odom[1]) >= n1 + 15
+    stop_cleanly(proc)
+
+
+def test_bad_options_are_refused(launch):
+    """Zero bodies or duplicate names: exit 2 with the reason, before any node starts."""
+    proc = launch(FLEET, '--', '--bodies', '0', name='zero')
+    assert proc.wait(20.0) == 2
+    assert '--bodies must be at least 1' in proc.output()
+    proc = launch(FLEET, '--', '--names', 'sat,sat', name='dupes')
+    assert proc.wait(20.0) == 2
+    assert 'body names must be unique' in proc.output()
