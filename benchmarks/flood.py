@@ -92,8 +92,11 @@ def flood(probe, kind):
     odom = probe.messages['odom']
     odom.clear()
     simulator = Process(sim('publish_clock:=true'))
-    flooder = Process(script(FLOODER) + [kind, str(RATE), str(SECONDS)])
+    flooder = None
     try:
+        probe.spin_until(lambda: probe.newest_status('torque command') is not None, 40.0,
+                         "the simulator's diagnostics")
+        flooder = Process(script(FLOODER) + [kind, str(RATE), str(SECONDS)])
         def started():
             flooder.log.seek(0)
             return b'start' in flooder.log.read()
@@ -112,14 +115,15 @@ def flood(probe, kind):
         sent_line = [ln for ln in flooder.log.read().decode().splitlines()
                      if ln.startswith('sent')][-1].split()
         sent, elapsed = int(sent_line[1]), float(sent_line[2])
-        took = sum(int(after[2][c]) - int(before[2][c] if before else 0) for c in COUNTERS)
+        took = sum(int(after[2][c]) - int(before[2][c]) for c in COUNTERS)
         missed_key = next(k for k in integ1[2] if k.startswith('missed deadlines'))
         missed = int(integ1[2][missed_key]) - int(integ0[2][missed_key])
         achieved = float(integ1[2]['achieved real-time factor'])
         error = deviation(odom[n0:]) if kind != 'valid body torque' else None
         alive = simulator.proc.poll() is None
     finally:
-        flooder.close()
+        if flooder is not None:
+            flooder.close()
         simulator.close()
     return (kind, sent / elapsed, took, took / sent, missed, achieved, odom_rate, cpu, error,
             alive)

@@ -31,6 +31,7 @@ from std_srvs.srv import Trigger
 from . import conversions as conv
 from .parameters import as_float, as_vector, check_change, ConfigurationError, descriptor
 from .runner import run
+from .throttle import ThrottledWarnings
 from ..physics import equations, estimators, Inertia, theory
 
 NODE_NAME = 'attitude_analyzer'
@@ -110,6 +111,7 @@ class AttitudeAnalyzer(Node):
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
+        self._warnings = ThrottledWarnings(self.get_logger(), period=5.0)
         num = {'dynamic_typing': True}
         self.declare_parameter('inertia', None, descriptor(
             'Principal moments [I1, I2, I3] (kg m^2) of the body in its odom child frame, or '
@@ -224,8 +226,8 @@ class AttitudeAnalyzer(Node):
         norm = float(np.linalg.norm(q))
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(w))) or norm < 0.5:
             self._restarts['non_finite'] += 1
-            self.get_logger().warn('odom sample with a non-finite or zero quaternion or rate '
-                                   'dropped', throttle_duration_sec=5.0)
+            self._warnings.warn('non-finite', 'odom sample with a non-finite or zero quaternion '
+                                'or rate dropped')
             return
         t = conv.time_ns(msg.header.stamp) * 1e-9
         s = self._settings

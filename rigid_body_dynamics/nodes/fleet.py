@@ -29,7 +29,7 @@ from rclpy.utilities import remove_ros_args
 
 from .parameters import ConfigurationError
 from .runner import run
-from .simulator import AttitudeSimulator, NODE_NAME
+from .simulator import AttitudeSimulator, NODE_NAME, SWITCH_INTERVAL
 
 
 def body_names(bodies, prefix, names):
@@ -67,6 +67,7 @@ class Fleet:
 
     def start(self):
         """Start stepping the bodies."""
+        sys.setswitchinterval(SWITCH_INTERVAL)
         if not self.shared:
             for node in self.nodes:
                 node.start()

@@ -38,6 +38,7 @@ from std_srvs.srv import SetBool, Trigger
 from . import conversions as conv
 from .parameters import as_float, as_vector, check_change, ConfigurationError, descriptor
 from .runner import run
+from .throttle import ThrottledWarnings
 from ..physics import Inertia, INTEGRATORS, make_integrator, presets, quaternions
 
 NODE_NAME = 'attitude_simulator'
@@ -53,6 +54,10 @@ LATE_LIMIT = 0.005
 #: at once and the executor starves.
 AFAP_BATCH = 0.005
 AFAP_YIELD = 0.0002
+#: Python's GIL switch interval for the simulator process (s). The default 5 ms
+#: lets a busy executor thread (a torque-command flood) hold the interpreter
+#: for 5 ms after the integration thread's deadline; 0.5 ms bounds that wait.
+SWITCH_INTERVAL = 0.0005
 
 STATE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
                        reliability=ReliabilityPolicy.RELIABLE,
@@ -97,6 +102,7 @@ class AttitudeSimulator(Node):
         self._apply(values, initial=True)
         self._counts = dict.fromkeys(
             ('accepted', 'rejected_non_finite', 'rejected_frame', 'clipped', 'force_ignored'), 0)
+        self._warnings = ThrottledWarnings(self.get_logger())
         self._make_interfaces()
         self._start_ns = 0 if self._publish_clock else self.get_clock().now().nanoseconds
         self._reset_state()
@@ -334,34 +340,33 @@ class AttitudeSimulator(Node):
         return TorqueCommand(vector, world, received_ns, principal)
 
     def _on_torque(self, msg):
-        log = self.get_logger()
+        warn = self._warnings.warn
         frame = msg.header.frame_id
         if not conv.is_finite_vector(msg.wrench.torque):
             with self._lock:
                 self._counts['rejected_non_finite'] += 1
-            log.warn('torque_cmd rejected: non-finite torque; state unchanged',
-                     throttle_duration_sec=1.0)
+            warn('non-finite', 'torque_cmd rejected: non-finite torque; state unchanged')
             return
         world_frame, body_frame = self._frames
         if frame not in ('', body_frame, world_frame):
             with self._lock:
                 self._counts['rejected_frame'] += 1
             shown = frame if len(frame) <= 64 else frame[:64] + '...'
-            log.warn(f'torque_cmd rejected: unknown frame_id {shown!r}; use {body_frame!r}, '
-                     f'{world_frame!r} or "" (= body)', throttle_duration_sec=1.0)
+            warn('frame', f'torque_cmd rejected: unknown frame_id {shown!r}; use '
+                 f'{body_frame!r}, {world_frame!r} or "" (= body)')
             return
         vector = conv.vector_array(msg.wrench.torque)
         with self._lock:
             if self._max_torque > 0.0 and np.any(np.abs(vector) > self._max_torque):
                 vector = np.clip(vector, -self._max_torque, self._max_torque)
                 self._counts['clipped'] += 1
-                log.warn(f'torque_cmd clipped to max_torque = {self._max_torque:g} N m per axis',
-                         throttle_duration_sec=1.0)
+                warn('clipped', f'torque_cmd clipped to max_torque = {self._max_torque:g} N m '
+                     'per axis')
             if not conv.is_finite_vector(msg.wrench.force) or any(
                     (msg.wrench.force.x, msg.wrench.force.y, msg.wrench.force.z)):
                 self._counts['force_ignored'] += 1
-                log.warn('torque_cmd carries a force; only the torque is used (the body does '
-                         'not translate)', once=True)
+                warn('force', 'torque_cmd carries a force; only the torque is used (the body '
+                     'does not translate)', period=math.inf)
             self._counts['accepted'] += 1
             self._command = self._make_command(tuple(float(c) for c in vector),
                                                frame == world_frame and frame != body_frame,
@@ -390,7 +395,8 @@ class AttitudeSimulator(Node):
 
     # ------------------------------------------------------------------ stepping
     def start(self):
-        """Start the integration thread."""
+        """Start the integration thread (and shorten the GIL switch interval, process-wide)."""
+        sys.setswitchinterval(SWITCH_INTERVAL)
         self._thread = threading.Thread(target=self._run, name='integration', daemon=True)
         self._thread.start()
 
@@ -445,9 +451,9 @@ class AttitudeSimulator(Node):
                     if late > LATE_LIMIT * _NS:
                         self._missed += 1
                     if behind * period > MAX_LAG * _NS:
-                        self.get_logger().warn(
-                            f'cannot keep up with real_time_factor {self._rtf:g}: dropped a '
-                            f'backlog of {behind} steps', throttle_duration_sec=5.0)
+                        self._warnings.warn(
+                            'backlog', f'cannot keep up with real_time_factor {self._rtf:g}: '
+                            f'dropped a backlog of {behind} steps', period=5.0)
                         self._anchor()
                         behind = 1
                     for _ in range(behind):
