@@ -8,8 +8,10 @@ integration thread, and one ``attitude_fleet`` process with an integration
 thread per body. For each count N the bodies start, run until every one has
 reported, and then for a window the CPU of all processes is summed and every
 body's diagnostics are read. N runs in real time when every body achieved a
-real-time factor of at least 0.99 and at most 2 steps of all bodies together
-were more than 5 ms late in the window. Each sweep ends after two failures in
+real-time factor of at least 0.99 and at most 2 of its steps were more than
+5 ms late in the window (the criterion of the single-node rate sweep, per
+body; in one process a single 5 ms stall of the machine makes every body late
+at once, so the total counts each stall N times). Each sweep ends after two failures in
 a row. ``./dev bench --only bodies`` (about 15 minutes).
 """
 
@@ -49,7 +51,7 @@ def integrator_statuses(probe, since=0):
 
 
 def run_bodies(probe, way, n, window):
-    """Run ``n`` bodies; returns (CPU in cores, missed, slowest real-time factor, reason)."""
+    """Run ``n`` bodies; returns (CPU in cores, (missed total, worst body), slowest RTF, why)."""
     diags = probe.messages['/diagnostics']
     diags.clear()
     procs = [Process(c) for c in commands(way, n)]
@@ -58,7 +60,7 @@ def run_bodies(probe, way, n, window):
         while len(integrator_statuses(probe)) < n and time.monotonic() < deadline:
             probe.spin_for(0.5)
         if len(integrator_statuses(probe)) < n:
-            return float('nan'), 0, 0.0, f'only {len(integrator_statuses(probe))} reported'
+            return float('nan'), (0, 0), 0.0, f'only {len(integrator_statuses(probe))} reported'
         probe.spin_for(3.0)
         first = len(diags)
         pids = [p.proc.pid for p in procs]
@@ -66,7 +68,8 @@ def run_bodies(probe, way, n, window):
         probe.spin_for(window)
         cpu = (sum(cpu_seconds(p) for p in pids) - c0) / (time.monotonic() - t0)
         seen = integrator_statuses(probe, max(first - 1, 0))
-        missed = sum(int(v[-1][MISSED]) - int(v[0][MISSED]) for v in seen.values())
+        per_body = [int(v[-1][MISSED]) - int(v[0][MISSED]) for v in seen.values()]
+        missed = (sum(per_body), max(per_body))
         slowest = min(float(v[-1]['achieved real-time factor']) for v in seen.values())
         return cpu, missed, slowest, '' if len(seen) == n else f'{len(seen)} of {n} reported'
     finally:
@@ -79,7 +82,7 @@ def measure(window=8.0, counts=COUNTS):
     probe = Probe('bench_bodies')
     probe.subscribe(DiagnosticArray, '/diagnostics')
     lines = ['| way | bodies | CPU (cores) | CPU per body (% of a core) | missed deadlines '
-             '(all bodies) | slowest achieved real-time factor | real time |',
+             '(all bodies / worst body) | slowest achieved real-time factor | real time |',
              '|---|---|---|---|---|---|---|']
     best = {}
     try:
@@ -87,8 +90,9 @@ def measure(window=8.0, counts=COUNTS):
             failures = 0
             for n in counts:
                 cpu, missed, slowest, why = run_bodies(probe, way, n, window)
-                ok = not why and missed <= MAX_MISSED and slowest >= 0.99
-                lines.append(f'| {way} | {n} | {cpu:.2f} | {100 * cpu / n:.1f} | {missed} | '
+                ok = not why and missed[1] <= MAX_MISSED and slowest >= 0.99
+                lines.append(f'| {way} | {n} | {cpu:.2f} | {100 * cpu / n:.1f} | '
+                             f'{missed[0]} / {missed[1]} | '
                              f'{slowest:.3f} | {"yes" if ok else "no"}{", " + why if why else ""}'
                              ' |')
                 print(lines[-1], flush=True)

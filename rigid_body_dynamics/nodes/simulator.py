@@ -311,7 +311,7 @@ class AttitudeSimulator(Node):
         self._stats = (time.monotonic_ns(), 0)
         self._baseline()
         self._anchor()
-        self._publish_state(self._snapshot())
+        self.publish_state(self._snapshot())
 
     def _baseline(self):
         """Remember T and L_w now: drift is reported since the last torque or change."""
@@ -421,15 +421,18 @@ class AttitudeSimulator(Node):
         if wait > 0.0:
             self._stop.wait(wait)
 
-    def step_due(self):
+    def step_due(self, outbox=None):
         """
         Integrate the steps that are due now (a batch, as fast as possible) and publish.
 
         Returns the wall time (s) until the next step is due. Called by this
         node's integration thread, or by one thread that steps many bodies
-        (attitude_fleet) instead of ``start()``.
+        (attitude_fleet) instead of ``start()``; given a list ``outbox``, the
+        snapshots of the publish ticks go there (for ``publish_state``)
+        instead of being published at once.
         """
-        outbox = []
+        publish_now = outbox is None
+        outbox = [] if publish_now else outbox
         with self._lock:
             if self._paused:
                 wait = 0.05
@@ -461,8 +464,9 @@ class AttitudeSimulator(Node):
                 next_due = self._anchor_ns + (self._steps + 1 - self._anchor_steps) * period
                 wait = max(0.0, (next_due - time.monotonic_ns()) / _NS)
         # publish outside the lock: a torque command never waits for publishing
-        for snapshot in outbox:
-            self._publish_state(snapshot)
+        if publish_now:
+            for snapshot in outbox:
+                self.publish_state(snapshot)
         return wait
 
     def _advance(self, now_ns, outbox):
@@ -485,7 +489,8 @@ class AttitudeSimulator(Node):
         s = self._stepper
         return (self._steps, s.q, s.omega, self._last_torque, self._inertia)
 
-    def _publish_state(self, snapshot):
+    def publish_state(self, snapshot):
+        """Publish the state topics of one publish tick (a snapshot taken under the lock)."""
         steps, q_p, w_p, torque, inertia = snapshot
         stamp = conv.time_msg(self._start_ns + int(steps * self._dt_ns))
         world, body_frame = self._frames
