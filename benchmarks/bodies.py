@@ -4,15 +4,16 @@ Many bodies on one machine: how many run in real time at 1 kHz integration and 1
 Three ways, all with the defaults of the symmetric top (exact integrator, 7
 state topics per body): one ``attitude_simulator`` process per body (a
 namespace each), one ``attitude_fleet`` process whose bodies share one
-integration thread, and one ``attitude_fleet`` process with an integration
-thread per body. For each count N the bodies start, run until every one has
+integration thread, one ``attitude_fleet`` process with an integration
+thread per body, and two ``attitude_fleet`` processes (half the bodies each,
+shared thread) to use both cores. For each count N the bodies start, run until every one has
 reported, and then for a window the CPU of all processes is summed and every
 body's diagnostics are read. N runs in real time when every body achieved a
 real-time factor of at least 0.99 and at most 2 of its steps were more than
 5 ms late in the window (the criterion of the single-node rate sweep, per
 body; in one process a single 5 ms stall of the machine makes every body late
 at once, so the total counts each stall N times). Each sweep ends after two failures in
-a row. ``./dev bench --only bodies`` (about 15 minutes).
+a row. ``./dev bench --only bodies`` (about 25 minutes).
 """
 
 import os
@@ -32,10 +33,18 @@ COUNTS = (1, 2, 4, 8, 12, 16, 24, 32, 48, 64)
 MISSED = 'missed deadlines (> 5 ms late)'
 
 
+WAYS = ('processes', 'fleet, shared thread', 'fleet, thread per body',
+        'two fleets, shared thread each')
+
+
 def commands(way, n):
     """Process command lines that run ``n`` bodies ``way``."""
     if way == 'processes':
         return [sim() + ['-r', f'__ns:=/body{k}'] for k in range(1, n + 1)]
+    if way.startswith('two fleets'):
+        halves = (range(1, n // 2 + 1), range(n // 2 + 1, n + 1))
+        return [FLEET + ['--names', ','.join(f'body{k}' for k in half), '--ros-args']
+                for half in halves if len(half)]
     threads = 'shared' if way == 'fleet, shared thread' else 'per-body'
     return [FLEET + ['--bodies', str(n), '--threads', threads, '--ros-args']]
 
@@ -86,7 +95,7 @@ def measure(window=8.0, counts=COUNTS):
              '|---|---|---|---|---|---|---|']
     best = {}
     try:
-        for way in ('processes', 'fleet, shared thread', 'fleet, thread per body'):
+        for way in WAYS:
             failures = 0
             for n in counts:
                 cpu, missed, slowest, why = run_bodies(probe, way, n, window)
@@ -103,6 +112,5 @@ def measure(window=8.0, counts=COUNTS):
                     break
     finally:
         probe.close()
-    summary = ', '.join(f'{way}: {best.get(way, 0)}' for way in
-                        ('processes', 'fleet, shared thread', 'fleet, thread per body'))
+    summary = ', '.join(f'{way}: {best.get(way, 0)}' for way in WAYS)
     return lines + ['', f'Most bodies in real time: {summary}.']

@@ -7,6 +7,7 @@ at its own stamp whatever the test happened to miss while discovering.
 """
 
 import math
+import os
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import InertiaStamped, Vector3Stamped, WrenchStamped
@@ -57,6 +58,16 @@ def set_params(probe, **values):
     request = SetParameters.Request(parameters=[
         Parameter(name, value=value).to_parameter_msg() for name, value in values.items()])
     return probe.call(SetParameters, f'{NODE}/set_parameters', request).results
+
+
+def thread_policies(pid):
+    """(scheduling policy, real-time priority) of every thread of a process, from /proc."""
+    found = []
+    for tid in os.listdir(f'/proc/{pid}/task'):
+        with open(f'/proc/{pid}/task/{tid}/stat') as f:
+            fields = f.read().rsplit(')', 1)[1].split()
+        found.append((int(fields[38]), int(fields[37])))   # stat fields 41 and 40
+    return found
 
 
 def stop_cleanly(proc):
@@ -292,4 +303,20 @@ def test_as_fast_as_possible_still_serves_services_and_diagnostics(launch, probe
     assert float(values['achieved real-time factor']) > 5.0
     assert probe.call(Trigger, f'{NODE}/reset', Trigger.Request(), timeout=10.0).success
     assert set_params(probe, max_torque=2.0)[0].successful
+    stop_cleanly(proc)
+
+
+def test_thread_priority_is_applied_or_refused_with_the_reason(launch, probe):
+    """SCHED_FIFO for the integration thread: used where allowed, a warning where not."""
+    proc = launch(SIM, '-p', 'thread_priority:=100', name='bad_priority')
+    assert proc.wait(20.0) == 1
+    assert 'thread_priority must be an integer from 0 to 99' in proc.output()
+    proc = launch(SIM, '-p', 'thread_priority:=10', name='priority')
+    odom = probe.subscribe(Odometry, 'odom')
+    probe.wait_for('odom', 20)
+    output = proc.output()
+    assert ('SCHED_FIFO at priority 10' in output) or ('SCHED_FIFO refused' in output)
+    if 'SCHED_FIFO at priority 10' in output:   # one thread really runs under it
+        assert (1, 10) in thread_policies(proc.proc.pid)
+    assert len(odom) >= 20
     stop_cleanly(proc)

@@ -36,6 +36,7 @@ from rclpy.utilities import remove_ros_args
 from .parameters import ConfigurationError
 from .runner import run
 from .simulator import AttitudeSimulator, NODE_NAME, SWITCH_INTERVAL
+from .simulator import use_thread_priority
 
 
 #: Wall time the shared thread spends publishing before it integrates the steps
@@ -97,6 +98,7 @@ class Fleet:
             node.stop()
 
     def _run(self):
+        use_thread_priority(self.nodes[0].thread_priority, self.nodes[0].get_logger())
         pending = collections.deque()
         try:
             while not self._stop.is_set():

@@ -17,6 +17,7 @@ ROS time at start-up, or 0 with ``publish_clock``, which also publishes it on
 """
 
 import math
+import os
 import sys
 import threading
 import time
@@ -69,6 +70,26 @@ CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                        reliability=ReliabilityPolicy.BEST_EFFORT)
 
 
+def use_thread_priority(priority, logger):
+    """
+    Put the calling thread under SCHED_FIFO at ``priority`` (1-99); 0 leaves it alone.
+
+    Logs the outcome; a refusal (no CAP_SYS_NICE / rtprio limit, not Linux)
+    is a warning, and the thread keeps normal scheduling.
+    """
+    if not priority:
+        return False
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except (AttributeError, OSError) as err:
+        logger.warning(f'thread_priority {priority}: SCHED_FIFO refused ({err}); the '
+                       'integration thread keeps normal scheduling (grant CAP_SYS_NICE or an '
+                       'rtprio limit to use it)')
+        return False
+    logger.info(f'integration thread runs under SCHED_FIFO at priority {priority}')
+    return True
+
+
 class TorqueCommand:
     """The held torque command: body- or world-frame vector (N m) and its steady receive time."""
 
@@ -94,6 +115,11 @@ class AttitudeSimulator(Node):
         self._frames = (self.get_parameter('world_frame').value,
                         self.get_parameter('body_frame').value)
         self._publish_clock = self.get_parameter('publish_clock').value
+        self.thread_priority = self.get_parameter('thread_priority').value
+        if isinstance(self.thread_priority, bool) or not isinstance(self.thread_priority, int) \
+                or not 0 <= self.thread_priority <= 99:
+            raise ConfigurationError('thread_priority must be an integer from 0 to 99, got '
+                                     f'{self.thread_priority!r}')
         rate = as_float('integration_rate', self.get_parameter('integration_rate').value,
                         1e-6, 1e5)
         self._rate = rate
@@ -175,6 +201,11 @@ class AttitudeSimulator(Node):
         self.declare_parameter('body_frame', 'base_link', descriptor(
             'Body frame id of angular_velocity, angular_momentum_body, applied_torque, imu.',
             read_only=True))
+        self.declare_parameter('thread_priority', 0, descriptor(
+            'SCHED_FIFO priority (1-99) of the integration thread on Linux, for fewer missed '
+            'deadlines on a loaded machine; 0 = normal scheduling. Needs CAP_SYS_NICE or an '
+            'rtprio limit (limits.conf); if refused, the node says so and runs normally.',
+            read_only=True, constraints='integer, 0 (off) or 1 to 99'))
         self.declare_parameter('publish_imu', True, descriptor(
             'Also publish sensor_msgs/Imu on imu (REP 145; no acceleration).', read_only=True))
 
@@ -407,6 +438,7 @@ class AttitudeSimulator(Node):
             self._thread.join(timeout=5.0)
 
     def _run(self):
+        use_thread_priority(self.thread_priority, self.get_logger())
         try:
             while not self._stop.is_set():
                 self._cycle()
