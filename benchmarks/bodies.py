@@ -50,7 +50,7 @@ def commands(way, n):
 
 
 def integrator_statuses(probe, since=0):
-    """{body's node name: [status values, oldest first]} of the diagnostics since index ``since``."""
+    """Map each body's node name to its integrator statuses (oldest first) from ``since`` on."""
     found = {}
     for array in probe.messages['/diagnostics'][since:]:
         for status in array.status:

@@ -97,6 +97,7 @@ def flood(probe, kind):
         probe.spin_until(lambda: probe.newest_status('torque command') is not None, 40.0,
                          "the simulator's diagnostics")
         flooder = Process(script(FLOODER) + [kind, str(RATE), str(SECONDS)])
+
         def started():
             flooder.log.seek(0)
             return b'start' in flooder.log.read()

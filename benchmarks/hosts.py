@@ -25,7 +25,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 TEST = os.path.join(HERE, '..', 'test')
 sys.path.insert(0, TEST)
 import netns  # noqa: E402, I100 (after the path set-up)
-from nodes import sim, ANALYZER  # noqa: E402
+from nodes import ANALYZER, sim  # noqa: E402
 
 OPERATOR = [sys.executable, os.path.join(TEST, 'netns_operator.py'), '--skip-analyzer',
             '--rounds', '200', '--period', '0.05']
@@ -108,7 +108,8 @@ def measure():
                 trips[host].extend(got)
                 rates[host].append(rate)
                 rounds[host] += sent
-        udp = {'sim': udp_echo(hosts, 'sim', 'sim'), 'operator': udp_echo(hosts, 'operator', 'sim')}
+        udp = {'sim': udp_echo(hosts, 'sim', 'sim'),
+               'operator': udp_echo(hosts, 'operator', 'sim')}
     for host in ('sim', 'operator'):
         got = np.array(trips[host])
         lines.append(f'| {labels[host]} | {got.size}/{rounds[host]} | '

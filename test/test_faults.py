@@ -30,9 +30,11 @@ def test_signal_at_any_moment_exits_zero_without_traceback(delay, tmp_path):
                                 stderr=subprocess.STDOUT)
         time.sleep(delay)
         proc.send_signal(sig)
-        assert proc.wait(15.0) == 0, open(tmp_path / f'{name}.log').read()
+        code = proc.wait(15.0)
         log.close()
-        assert 'Traceback' not in open(tmp_path / f'{name}.log').read()
+        output = open(tmp_path / f'{name}.log').read()
+        assert code == 0 and 'Traceback' not in output, f'exit code {code}:\n{output}'
+
 
 
 def test_analyzer_crash_and_simulator_restart(launch, probe, monkeypatch):

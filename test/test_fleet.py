@@ -28,7 +28,7 @@ PARAMS = """\
 
 
 def nanoseconds(msg):
-    """Header stamp in integer nanoseconds (a float of seconds since 1970 keeps only 0.2 us)."""
+    """Return the header stamp as an integer count of ns; float seconds since 1970 keep 0.2 us."""
     return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
 
 

@@ -24,7 +24,7 @@ ANALYZER = 'rigid_body_dynamics.nodes.analyzer'
 
 @pytest.fixture
 def hosts():
-    """Three hosts (sim, analyzer, operator) on a private subnet, removed after the test."""
+    """Make three hosts, sim, analyzer and operator, on a private subnet; removed afterwards."""
     reason = netns.unavailable()
     if reason:
         pytest.skip(reason)

@@ -31,11 +31,12 @@ import threading
 import time
 
 import rclpy
+from rclpy.clock import Clock, ClockType
 from rclpy.utilities import remove_ros_args
 
 from .parameters import ConfigurationError
 from .runner import run
-from .simulator import AttitudeSimulator, NODE_NAME, SWITCH_INTERVAL
+from .simulator import AttitudeSimulator, DIAGNOSTIC_PERIOD, NODE_NAME, SWITCH_INTERVAL
 from .simulator import use_thread_priority
 
 
@@ -69,15 +70,27 @@ class Fleet:
         self._thread = None
         try:
             for name in names:
-                self.nodes.append(AttitudeSimulator(namespace='/' + name, **kwargs))
+                self.nodes.append(AttitudeSimulator(namespace='/' + name,
+                                                    diagnostics_timer=False, **kwargs))
         except Exception:
             for node in self.nodes:
                 node.destroy_node()
             raise
+        # Each executor wake-up rebuilds the wait set of every body (about 0.3 ms
+        # per body, holding the GIL), so the bodies have no diagnostics timers of
+        # their own: the shared thread publishes their diagnostics within its
+        # publishing budget, or (thread per body) one timer serves them all.
+        if not shared:
+            self.nodes[0].create_timer(DIAGNOSTIC_PERIOD, self._publish_diagnostics,
+                                       clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.nodes[0].get_logger().info(
             f'{len(self.nodes)} bodies in this process ({", ".join(names[:5])}'
             f'{", ..." if len(names) > 5 else ""}), '
             f'{"one shared integration thread" if shared else "one integration thread each"}')
+
+    def _publish_diagnostics(self):
+        for node in self.nodes:
+            node.publish_diagnostics()
 
     def start(self):
         """Start stepping the bodies."""
@@ -100,24 +113,32 @@ class Fleet:
     def _run(self):
         use_thread_priority(self.nodes[0].thread_priority, self.nodes[0].get_logger())
         pending = collections.deque()
+        next_diagnostics = time.monotonic() + DIAGNOSTIC_PERIOD
         try:
             while not self._stop.is_set():
+                now = time.monotonic()
+                if now >= next_diagnostics:
+                    next_diagnostics = max(next_diagnostics + DIAGNOSTIC_PERIOD, now)
+                    pending.extend((node, None) for node in self.nodes)
                 wait = math.inf
                 for node in self.nodes:
                     outbox = []
                     wait = min(wait, node.step_due(outbox))
                     pending.extend((node, snapshot) for snapshot in outbox)
                 # publish within a budget, then look at the deadlines again; a
-                # backlog beyond two ticks of every body is published at once
+                # backlog beyond three items per body is published at once
                 end = time.perf_counter() + PUBLISH_BUDGET
                 while pending and (time.perf_counter() < end
-                                   or len(pending) > 2 * len(self.nodes)):
+                                   or len(pending) > 3 * len(self.nodes)):
                     node, snapshot = pending.popleft()
-                    node.publish_state(snapshot)
+                    if snapshot is None:
+                        node.publish_diagnostics()
+                    else:
+                        node.publish_state(snapshot)
                 if pending:
                     wait = 0.0
                 if wait > 0.0:
-                    self._stop.wait(min(wait, 0.05))
+                    self._stop.wait(min(wait, next_diagnostics - time.monotonic(), 0.05))
         except Exception as err:  # a publisher closed under us at shutdown ends the loop
             if rclpy.ok(context=self.nodes[0].context) and not self._stop.is_set():
                 self.nodes[0].get_logger().error(f'fleet integration thread stopped: {err!r}')

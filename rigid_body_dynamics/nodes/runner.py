@@ -4,12 +4,14 @@ Run a node as a process: clean exit on Ctrl-C / SIGTERM, exit code 1 on bad conf
 rclpy's own SIGINT handling raises KeyboardInterrupt wherever the main
 thread happens to be, inside a garbage-collector finalizer included ("Exception
 ignored in Task.__del__" on stderr), and can race a message take against the
-context shutdown. Here the signals only set a flag; the executor spins in
-short slices and checks it, so shutdown always happens between callbacks.
+context shutdown. Here the signals only set a flag; the main thread sleeps and
+checks it, then wakes the executor thread and waits for it, so shutdown always
+happens between callbacks.
 """
 
 import signal
 import threading
+import time
 
 import rclpy
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
@@ -20,6 +22,44 @@ from .parameters import ConfigurationError
 
 #: Longest time between two looks at the stop flag (s).
 SLICE = 0.1
+#: Longest time the executor waits for work before it looks at the flag itself (s).
+IDLE_TIMEOUT = 2.0
+
+
+def _spin(nodes, stop):
+    """
+    Spin ``nodes`` on an executor thread until ``stop`` is set; the main thread waits.
+
+    The main thread sleeps in SLICE steps (a signal handler runs at once and
+    only sets ``stop``), then wakes the executor through a guard condition;
+    the executor itself waits for work with a long timeout, so an idle node
+    does not rebuild its wait set ten times a second (0.3 ms per node each
+    time, holding the interpreter). An exception raised in a callback ends
+    the spinning and is raised here.
+    """
+    executor = SingleThreadedExecutor()
+    for each in nodes:
+        executor.add_node(each)
+    wake = nodes[0].create_guard_condition(lambda: None)
+    failure = []
+
+    def spin():
+        try:
+            while not stop.is_set() and rclpy.ok():
+                executor.spin_once(timeout_sec=IDLE_TIMEOUT)
+        except BaseException as err:  # handed to the main thread
+            failure.append(err)
+        finally:
+            stop.set()
+    thread = threading.Thread(target=spin, name='executor')
+    thread.start()
+    while not stop.is_set():
+        time.sleep(SLICE)
+    wake.trigger()
+    thread.join()
+    nodes[0].destroy_guard_condition(wake)
+    if failure:
+        raise failure[0]
 
 
 def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
@@ -48,11 +88,7 @@ def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
         node = make_node()
         if on_start and not stop.is_set():
             on_start(node)
-        executor = SingleThreadedExecutor()
-        for each in getattr(node, 'nodes', [node]):
-            executor.add_node(each)
-        while not stop.is_set() and rclpy.ok():
-            executor.spin_once(timeout_sec=SLICE)
+        _spin(getattr(node, 'nodes', [node]), stop)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except (ConfigurationError, InvalidParameterValueException,

@@ -55,6 +55,8 @@ LATE_LIMIT = 0.005
 #: at once and the executor starves.
 AFAP_BATCH = 0.005
 AFAP_YIELD = 0.0002
+#: Period of /diagnostics (s, steady clock).
+DIAGNOSTIC_PERIOD = 1.0
 #: Python's GIL switch interval for the simulator process (s). The default 5 ms
 #: lets a busy executor thread (a torque-command flood) hold the interpreter
 #: for 5 ms after the integration thread's deadline; 0.5 ms bounds that wait.
@@ -103,9 +105,14 @@ class TorqueCommand:
 
 
 class AttitudeSimulator(Node):
-    """The attitude_simulator node. ``kwargs`` go to rclpy's Node (context, overrides)."""
+    """
+    The attitude_simulator node. ``kwargs`` go to rclpy's Node (context, overrides).
 
-    def __init__(self, **kwargs):
+    ``diagnostics_timer=False`` leaves the 1 Hz diagnostics to the caller
+    (``publish_diagnostics``), as attitude_fleet does with one timer for all.
+    """
+
+    def __init__(self, diagnostics_timer=True, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
         self._lock = threading.RLock()
         self._stop = threading.Event()
@@ -129,7 +136,7 @@ class AttitudeSimulator(Node):
         self._counts = dict.fromkeys(
             ('accepted', 'rejected_non_finite', 'rejected_frame', 'clipped', 'force_ignored'), 0)
         self._warnings = ThrottledWarnings(self.get_logger())
-        self._make_interfaces()
+        self._make_interfaces(diagnostics_timer)
         self._start_ns = 0 if self._publish_clock else self.get_clock().now().nanoseconds
         self._reset_state()
         self._publish_inertia()
@@ -301,7 +308,7 @@ class AttitudeSimulator(Node):
                                                    self._command.received_ns)
 
     # ------------------------------------------------------------------ interfaces
-    def _make_interfaces(self):
+    def _make_interfaces(self, diagnostics_timer):
         qos_opts = QoSOverridingOptions.with_default_policies()
 
         def pub(msg_type, name, qos=STATE_QOS):
@@ -322,8 +329,9 @@ class AttitudeSimulator(Node):
                                  qos_overriding_options=qos_opts)
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
-        steady = Clock(clock_type=ClockType.STEADY_TIME)
-        self.create_timer(1.0, self._publish_diagnostics, clock=steady)
+        if diagnostics_timer:   # else someone calls publish_diagnostics (attitude_fleet)
+            steady = Clock(clock_type=ClockType.STEADY_TIME)
+            self.create_timer(DIAGNOSTIC_PERIOD, self.publish_diagnostics, clock=steady)
 
     # ------------------------------------------------------------------ state
     def _reset_state(self):
@@ -571,7 +579,8 @@ class AttitudeSimulator(Node):
         msg.inertia.iyy, msg.inertia.iyz, msg.inertia.izz = t[1, 1], t[1, 2], t[2, 2]
         self._pub_inertia.publish(msg)
 
-    def _publish_diagnostics(self):
+    def publish_diagnostics(self):
+        """Publish /diagnostics and ~/real_time_factor (every DIAGNOSTIC_PERIOD s)."""
         name = self.get_name()
         hw = self.get_fully_qualified_name()
         with self._lock:
