@@ -36,7 +36,6 @@ def test_signal_at_any_moment_exits_zero_without_traceback(delay, tmp_path):
         assert code == 0 and 'Traceback' not in output, f'exit code {code}:\n{output}'
 
 
-
 def test_analyzer_crash_and_simulator_restart(launch, probe, monkeypatch):
     """A killed analyzer restarts and recovers; a restarted simulator is detected."""
     monkeypatch.setenv('FASTDDS_BUILTIN_TRANSPORTS', 'UDPv4')
