@@ -100,3 +100,10 @@ def test_bad_options_are_refused(launch):
     proc = launch(FLEET, '--', '--names', 'sat,sat', name='dupes')
     assert proc.wait(20.0) == 2
     assert 'body names must be unique' in proc.output()
+
+
+def test_one_clock_source_only(launch):
+    """publish_clock for every body would give /clock several sources: refused with the reason."""
+    proc = launch(FLEET, '-p', 'publish_clock:=true', '--', '--bodies', '2', name='clocks')
+    assert proc.wait(20.0) == 1
+    assert 'publish_clock is set for 2 bodies' in proc.output()

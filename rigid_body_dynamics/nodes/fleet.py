@@ -19,6 +19,11 @@ shared thread publishes the ticks within a time budget between integration
 passes, so the steps stay on time while the publishing of the last bodies
 lags by a few ms.
 
+One body at most may publish /clock (``publish_clock``). A body at
+``real_time_factor`` 0 integrates in 5 ms batches on the shared thread, which
+makes the other bodies' steps late: as-fast-as-possible runs belong in their
+own process.
+
 ``attitude_fleet [--bodies N] [--prefix body] [--names a,b,...] [--threads
 shared|per-body] [--ros-args ...]``
 """
@@ -72,6 +77,13 @@ class Fleet:
             for name in names:
                 self.nodes.append(AttitudeSimulator(namespace='/' + name,
                                                     diagnostics_timer=False, **kwargs))
+            clocks = [n.get_namespace() for n in self.nodes if n.get_parameter(
+                'publish_clock').value]
+            if len(clocks) > 1:
+                raise ConfigurationError(
+                    f'publish_clock is set for {len(clocks)} bodies ({", ".join(clocks[:3])}'
+                    f'{", ..." if len(clocks) > 3 else ""}); /clock must have one source, so '
+                    'set it for one body only (key /<name>/attitude_simulator)')
         except Exception:
             for node in self.nodes:
                 node.destroy_node()
