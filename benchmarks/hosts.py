@@ -16,6 +16,7 @@ UDP echo (1000 datagrams), within one host and between two. ``./dev bench
 
 import json
 import os
+import subprocess
 import sys
 import textwrap
 
@@ -26,6 +27,7 @@ TEST = os.path.join(HERE, '..', 'test')
 sys.path.insert(0, TEST)
 import netns  # noqa: E402, I100 (after the path set-up)
 from nodes import ANALYZER, sim  # noqa: E402
+from ros_harness import interrupt  # noqa: E402
 
 OPERATOR = [sys.executable, os.path.join(TEST, 'netns_operator.py'), '--skip-analyzer',
             '--rounds', '200', '--period', '0.05']
@@ -73,10 +75,9 @@ def udp_echo(hosts, source, target):
 
 def placement(hosts, operator_host):
     """Round trips (s) with the operator on ``operator_host``."""
-    procs = [hosts.popen('sim', sim('publish_rate:=1000.0', 'torque_timeout:=0.0'),
-                         stdout=open(os.devnull, 'w'), stderr=open(os.devnull, 'w')),
-             hosts.popen('analyzer', ANALYZER, stdout=open(os.devnull, 'w'),
-                         stderr=open(os.devnull, 'w'))]
+    quiet = {'stdout': subprocess.DEVNULL, 'stderr': subprocess.DEVNULL}
+    procs = [hosts.popen('sim', sim('publish_rate:=1000.0', 'torque_timeout:=0.0'), **quiet),
+             hosts.popen('analyzer', ANALYZER, **quiet)]
     try:
         done = hosts.run(operator_host, OPERATOR, timeout=120)
         if done.returncode != 0:
@@ -84,8 +85,7 @@ def placement(hosts, operator_host):
         report = json.loads(done.stdout.strip().splitlines()[-1])
     finally:
         for p in procs:
-            p.send_signal(2)
-            p.wait(10.0)
+            interrupt(p)
     return np.array(report['round_trips']), report['odom_rate'], report['rounds']
 
 

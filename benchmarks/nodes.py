@@ -24,7 +24,7 @@ from rigid_body_dynamics.nodes.conversions import status_values
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..', 'test'))
-from ros_harness import Probe  # noqa: E402
+from ros_harness import interrupt, Probe  # noqa: E402
 
 SIM = [sys.executable, '-m', 'rigid_body_dynamics.nodes.simulator', '--ros-args']
 ANALYZER = [sys.executable, '-m', 'rigid_body_dynamics.nodes.analyzer', '--ros-args']
@@ -87,11 +87,7 @@ class Process:
 
     def close(self):
         """Stop with SIGINT (kill after 10 s)."""
-        self.proc.send_signal(2)
-        try:
-            self.proc.wait(10.0)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
+        interrupt(self.proc)
 
 
 def script(source):

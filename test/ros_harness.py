@@ -27,6 +27,18 @@ LATCHED = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
+def interrupt(proc, timeout=10.0):
+    """SIGINT a subprocess.Popen (as Ctrl-C does) and wait; kill after ``timeout`` s; exit code."""
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+        try:
+            proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(5.0)
+    return proc.returncode
+
+
 class NodeProcess:
     """A node started as its own process; ``stop()`` sends SIGINT and returns the exit code."""
 
@@ -47,15 +59,9 @@ class NodeProcess:
     def stop(self, timeout=10.0):
         """SIGINT, then wait; kill after ``timeout`` s. Returns (exit code, seconds taken)."""
         start = time.monotonic()
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGINT)
-            try:
-                self.proc.wait(timeout)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(5.0)
+        code = interrupt(self.proc, timeout)
         self._log.close()
-        return self.proc.returncode, time.monotonic() - start
+        return code, time.monotonic() - start
 
     def wait(self, timeout):
         """Wait for the process to end by itself; returns its exit code."""

@@ -9,6 +9,7 @@ moment. (``python -m rigid_body_dynamics.nodes.<node>`` imports first and so
 is only covered once ``main`` runs.)
 """
 
+import importlib
 import signal
 
 
@@ -20,29 +21,16 @@ def _guard():
     return received
 
 
-def simulator():
-    """Entry point of attitude_simulator."""
-    early = _guard()
-    from .simulator import main
-    return main(early=early)
+def _entry(module, executable):
+    """Make the console entry point of ``executable``: guard first, then import ``module``."""
+    def entry():
+        early = _guard()
+        return importlib.import_module(f'{__package__}.{module}').main(early=early)
+    entry.__doc__ = f'Entry point of {executable}.'
+    return entry
 
 
-def analyzer():
-    """Entry point of attitude_analyzer."""
-    early = _guard()
-    from .analyzer import main
-    return main(early=early)
-
-
-def poinsot():
-    """Entry point of poinsot_visualizer."""
-    early = _guard()
-    from .poinsot import main
-    return main(early=early)
-
-
-def fleet():
-    """Entry point of attitude_fleet."""
-    early = _guard()
-    from .fleet import main
-    return main(early=early)
+simulator = _entry('simulator', 'attitude_simulator')
+analyzer = _entry('analyzer', 'attitude_analyzer')
+poinsot = _entry('poinsot', 'poinsot_visualizer')
+fleet = _entry('fleet', 'attitude_fleet')

@@ -35,14 +35,13 @@ import sys
 import threading
 import time
 
-import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.utilities import remove_ros_args
 
 from .parameters import ConfigurationError
 from .runner import run
-from .simulator import AttitudeSimulator, DIAGNOSTIC_PERIOD, NODE_NAME, SWITCH_INTERVAL
-from .simulator import use_thread_priority
+from .simulator import AttitudeSimulator, DIAGNOSTIC_PERIOD, integration_loop, NODE_NAME
+from .simulator import SWITCH_INTERVAL
 
 
 #: Wall time the shared thread spends publishing before it integrates the steps
@@ -111,7 +110,12 @@ class Fleet:
             for node in self.nodes:
                 node.start()
             return
-        self._thread = threading.Thread(target=self._run, name='fleet integration', daemon=True)
+        self._pending = collections.deque()   # (node, snapshot or None = diagnostics)
+        self._outbox = []
+        self._next_diagnostics = time.monotonic() + DIAGNOSTIC_PERIOD
+        self._thread = threading.Thread(target=integration_loop, name='fleet integration',
+                                        args=(self._cycle, self._stop, self.nodes[0]),
+                                        daemon=True)
         self._thread.start()
 
     def stop(self):
@@ -122,39 +126,31 @@ class Fleet:
         for node in self.nodes:
             node.stop()
 
-    def _run(self):
-        use_thread_priority(self.nodes[0].thread_priority, self.nodes[0].get_logger())
-        pending = collections.deque()
-        next_diagnostics = time.monotonic() + DIAGNOSTIC_PERIOD
-        try:
-            while not self._stop.is_set():
-                now = time.monotonic()
-                if now >= next_diagnostics:
-                    next_diagnostics = max(next_diagnostics + DIAGNOSTIC_PERIOD, now)
-                    pending.extend((node, None) for node in self.nodes)
-                wait = math.inf
-                for node in self.nodes:
-                    outbox = []
-                    wait = min(wait, node.step_due(outbox))
-                    pending.extend((node, snapshot) for snapshot in outbox)
-                # publish within a budget, then look at the deadlines again; a
-                # backlog beyond three items per body is published at once
-                end = time.perf_counter() + PUBLISH_BUDGET
-                while pending and (time.perf_counter() < end
-                                   or len(pending) > 3 * len(self.nodes)):
-                    node, snapshot = pending.popleft()
-                    if snapshot is None:
-                        node.publish_diagnostics()
-                    else:
-                        node.publish_state(snapshot)
-                if pending:
-                    wait = 0.0
-                if wait > 0.0:
-                    self._stop.wait(min(wait, next_diagnostics - time.monotonic(), 0.05))
-        except Exception as err:  # a publisher closed under us at shutdown ends the loop
-            if rclpy.ok(context=self.nodes[0].context) and not self._stop.is_set():
-                self.nodes[0].get_logger().error(f'fleet integration thread stopped: {err!r}')
-                raise
+    def _cycle(self):
+        """Integrate every body's due steps, publish within the budget, sleep if nothing is due."""
+        now = time.monotonic()
+        pending = self._pending
+        if now >= self._next_diagnostics:
+            self._next_diagnostics = max(self._next_diagnostics + DIAGNOSTIC_PERIOD, now)
+            pending.extend((node, None) for node in self.nodes)
+        wait = math.inf
+        outbox = self._outbox
+        for node in self.nodes:
+            wait = min(wait, node.step_due(outbox))
+            if outbox:
+                pending.extend((node, snapshot) for snapshot in outbox)
+                outbox.clear()
+        # publish within a budget, then look at the deadlines again; a backlog
+        # beyond three items per body is published at once
+        end = time.perf_counter() + PUBLISH_BUDGET
+        while pending and (time.perf_counter() < end or len(pending) > 3 * len(self.nodes)):
+            node, snapshot = pending.popleft()
+            if snapshot is None:
+                node.publish_diagnostics()
+            else:
+                node.publish_state(snapshot)
+        if not pending and wait > 0.0:
+            self._stop.wait(min(wait, self._next_diagnostics - time.monotonic(), 0.05))
 
 
 def main(args=None, early=None):

@@ -80,16 +80,33 @@ def use_thread_priority(priority, logger):
     is a warning, and the thread keeps normal scheduling.
     """
     if not priority:
-        return False
+        return
     try:
         os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
     except (AttributeError, OSError) as err:
         logger.warning(f'thread_priority {priority}: SCHED_FIFO refused ({err}); the '
                        'integration thread keeps normal scheduling (grant CAP_SYS_NICE or an '
                        'rtprio limit to use it)')
-        return False
+        return
     logger.info(f'integration thread runs under SCHED_FIFO at priority {priority}')
-    return True
+
+
+def integration_loop(cycle, stop, node):
+    """
+    Call ``cycle()`` until the event ``stop`` is set: the body of an integration thread.
+
+    Applies ``node``'s thread_priority first. An error after shutdown began
+    (a publisher closed under the loop) ends it quietly; any other is logged
+    on ``node`` and raised.
+    """
+    use_thread_priority(node.thread_priority, node.get_logger())
+    try:
+        while not stop.is_set():
+            cycle()
+    except Exception as err:
+        if rclpy.ok(context=node.context) and not stop.is_set():
+            node.get_logger().error(f'integration thread stopped: {err!r}')
+            raise
 
 
 class TorqueCommand:
@@ -436,7 +453,8 @@ class AttitudeSimulator(Node):
     def start(self):
         """Start the integration thread (and shorten the GIL switch interval, process-wide)."""
         sys.setswitchinterval(SWITCH_INTERVAL)
-        self._thread = threading.Thread(target=self._run, name='integration', daemon=True)
+        self._thread = threading.Thread(target=integration_loop, name='integration',
+                                        args=(self._cycle, self._stop, self), daemon=True)
         self._thread.start()
 
     def stop(self):
@@ -444,16 +462,6 @@ class AttitudeSimulator(Node):
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
-
-    def _run(self):
-        use_thread_priority(self.thread_priority, self.get_logger())
-        try:
-            while not self._stop.is_set():
-                self._cycle()
-        except Exception as err:  # a publisher closed under us at shutdown ends the loop
-            if rclpy.ok(context=self.context) and not self._stop.is_set():
-                self.get_logger().error(f'integration thread stopped: {err!r}')
-                raise
 
     def _cycle(self):
         """Integrate and publish the steps that are due, then sleep until the next is due."""
