@@ -51,12 +51,14 @@ def round_trips(probe, rounds, period):
     arrivals = {}
 
     def on_applied(msg):
-        key = round(msg.wrench.torque.x / TORQUE_UNIT)
+        key = 'hello' if msg.wrench.torque.y else round(msg.wrench.torque.x / TORQUE_UNIT)
         arrivals.setdefault(key, time.monotonic())
     probe.node.create_subscription(WrenchStamped, 'applied_torque', on_applied,
                                    QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
     pub = probe.publisher(WrenchStamped, 'torque_cmd')
-    probe.spin_for(1.0)
+    hello = WrenchStamped()                            # until it comes back: matched both ways
+    hello.wrench.torque.y = TORQUE_UNIT
+    probe.handshake(pub, hello, lambda: 'hello' in arrivals)
     sent = {}
     for k in range(1, rounds + 1):
         msg = WrenchStamped()

@@ -13,11 +13,14 @@ import subprocess
 import sys
 import time
 
+from nav_msgs.msg import Odometry
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rigid_body_dynamics.nodes.conversions import status_values
+from rigid_body_dynamics.nodes.conversions import quaternion_msg, status_values, time_msg
+from rigid_body_dynamics.nodes.conversions import time_ns
+from rigid_body_dynamics.nodes.conversions import vector_msg
 
 #: Subscriber QoS for the tests: reliable with a deep queue, so nothing is dropped.
 DEEP = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10000,
@@ -37,6 +40,43 @@ def interrupt(proc, timeout=10.0):
             proc.kill()
             proc.wait(5.0)
     return proc.returncode
+
+
+def odom_msg(t, q, w):
+    """Odometry odom -> base_link at ``t`` (s): attitude ``q`` (x, y, z, w), body rate ``w``."""
+    msg = Odometry()
+    msg.header.stamp = time_msg(int(round(t * 1e9)))
+    msg.header.frame_id, msg.child_frame_id = 'odom', 'base_link'
+    msg.pose.pose.orientation = quaternion_msg(q)
+    msg.twist.twist.angular = vector_msg(w)
+    return msg
+
+
+def relative(msgs, start_ns):
+    """
+    Copy Odometry messages with stamps made relative to ``start_ns`` (the node's start).
+
+    The simulator stamps start + simulated time, start being the ROS time at start-up;
+    its latched inertia carries start. Integer ns: float seconds since 1970 keep 0.2 us.
+    """
+    out = []
+    for m in msgs:
+        copy = Odometry()
+        copy.pose, copy.twist = m.pose, m.twist
+        copy.header.stamp = time_msg(time_ns(m.header.stamp) - start_ns)
+        out.append(copy)
+    return out
+
+
+def status_count(probe, name, key):
+    """Integer ``key`` of the newest /diagnostics status ``name`` (0 before there is one)."""
+    found = probe.newest_status(name)
+    return int(found[2].get(key, 0)) if found else 0
+
+
+def analyzer_heard(probe):
+    """Tell whether the analyzer's diagnostics count any odom (needs /diagnostics subscribed)."""
+    return status_count(probe, 'input', 'messages received') > 0
 
 
 class NodeProcess:
@@ -113,6 +153,30 @@ class Probe:
         self.spin_until(lambda: pub.get_subscription_count() >= subscribers, timeout,
                         f'a subscriber on {topic}')
         return pub
+
+    def handshake(self, pub, msg, heard, timeout=20.0, period=0.5):
+        """
+        Publish ``msg`` every ``period`` s until ``heard()`` holds; return how many were sent.
+
+        ``publisher()`` returns once our writer has matched the node's reader, but
+        discovery is two one-way exchanges: the node's reader may not know our writer
+        yet, and a volatile reader loses what it is sent until it does (seen in CI: a
+        whole burst of 600 messages lost). So the first message that matters is
+        repeated until ``heard`` (a predicate on what the probe received) shows the
+        node took it; from then on the pair is matched both ways.
+        """
+        sent = 0
+        deadline = time.monotonic() + timeout
+        while not heard():
+            if time.monotonic() > deadline:
+                raise AssertionError(f'timed out after {timeout} s: {sent} messages on '
+                                     f'{pub.topic_name} never reached the node')
+            pub.publish(msg)
+            sent += 1
+            until = min(time.monotonic() + period, deadline)
+            while not heard() and time.monotonic() < until:
+                self.executor.spin_once(timeout_sec=0.02)
+        return sent
 
     def call(self, srv_type, name, request, timeout=20.0):
         """Call a service and return its response."""

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from rcl_interfaces.srv import SetParametersAtomically
 from rclpy.parameter import Parameter
-from rigid_body_dynamics.nodes.conversions import quaternion_msg, time_msg
 from rigid_body_dynamics.nodes.conversions import vector_msg
 from rigid_body_dynamics.physics import FreeRigidBody, presets, theory
+from ros_harness import analyzer_heard, odom_msg
 from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
@@ -140,12 +140,14 @@ def test_torque_pulses_keep_balance_laws_ok(launch, probe):
                 'free-motion conservation')
     probe.wait_for('kinetic_energy', 1, timeout=20.0)   # matched later than /diagnostics, maybe
     e_before = energy[-1].data
+    applied = probe.subscribe(WrenchStamped, 'applied_torque')
     torque = probe.publisher(WrenchStamped, 'torque_cmd')
     for vec in ((0.3, 0.1, 0.5), (-0.2, 0.3, 0.4)):
         msg = WrenchStamped()
         msg.header.frame_id = 'base_link'
         msg.wrench.torque = vector_msg(vec)
-        torque.publish(msg)
+        probe.handshake(torque, msg,
+                        lambda: applied and applied[-1].wrench.torque == msg.wrench.torque)
         probe.spin_for(0.6)
     level, message, values = wait_status(
         probe, 'conservation', lambda v: v.get('mode', '').startswith('balance'), 10.0,
@@ -168,22 +170,24 @@ def _publish_states(probe, pub, times, body, scale=None):
     """Publish exact top states at ``times`` (s) as odom, optionally scaling omega by scale(t)."""
     q, w = body.state_at(np.asarray(times))
     for k, t in enumerate(times):
-        msg = Odometry()
-        msg.header.stamp = time_msg(int(round(t * 1e9)))
-        msg.header.frame_id, msg.child_frame_id = 'odom', 'base_link'
-        msg.pose.pose.orientation = quaternion_msg(q[k])
-        omega = w[k] * (scale(t) if scale else 1.0)
-        msg.twist.twist.angular = vector_msg(omega)
-        pub.publish(msg)
+        pub.publish(odom_msg(t, q[k], w[k] * (scale(t) if scale else 1.0)))
         if k % 50 == 0:
             probe.spin_for(0.005)
+
+
+def _odom_publisher(probe, body):
+    """Odom publisher, once the analyzer counted a first sample (``body`` at t = 0) from it."""
+    pub = probe.publisher(Odometry, 'odom')
+    q, w = body.state_at(np.array([0.0]))
+    probe.handshake(pub, odom_msg(0.0, q[0], w[0]), lambda: analyzer_heard(probe))
+    return pub
 
 
 def test_broken_physics_turns_conservation_to_error(launch, probe):
     analyzer = launch(ANALYZER, '-p', 'inertia:=[1.0, 1.0, 1.5]', name='analyzer')
     probe.subscribe(DiagnosticArray, '/diagnostics')
-    pub = probe.publisher(Odometry, 'odom')
     body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    pub = _odom_publisher(probe, body)
     # a "simulator" whose energy drifts by 2e-4 per second of stamps, fed second by second
     # until the analyzer (baseline at its first analysis, whenever that is) sees the drift
 
@@ -208,8 +212,8 @@ def test_dropped_duplicated_reordered_and_time_reset(launch, probe, rng):
     analyzer = launch(ANALYZER, '-p', 'inertia:=[1.0, 1.0, 1.5]', '-p', 'window:=5.0',
                       name='analyzer')
     probe.subscribe(DiagnosticArray, '/diagnostics')
-    pub = probe.publisher(Odometry, 'odom')
     body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    pub = _odom_publisher(probe, body)
 
     def messy(t0, t1):
         t = np.arange(t0, t1, 0.01)
@@ -245,8 +249,8 @@ def test_without_inertia_nothing_is_made_up(launch, probe):
     probe.subscribe(DiagnosticArray, '/diagnostics')
     rates = probe.subscribe(Float64, 'precession/body_rate')
     energy = probe.subscribe(Float64, 'kinetic_energy')
-    pub = probe.publisher(Odometry, 'odom')
     body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    pub = _odom_publisher(probe, body)
     _publish_states(probe, pub, np.arange(0.0, 3.0, 0.01), body)
     probe.spin_for(2.5)
     level, message, values = probe.newest_status('attitude_analyzer: precession')

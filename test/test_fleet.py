@@ -11,9 +11,9 @@ from geometry_msgs.msg import InertiaStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
-from rigid_body_dynamics.nodes.conversions import status_values
+from rigid_body_dynamics.nodes.conversions import status_values, time_ns
 from rigid_body_dynamics.physics import presets
-from ros_harness import LATCHED
+from ros_harness import LATCHED, relative
 from std_srvs.srv import SetBool
 from test_simulator_node import assert_exact, stamp, stop_cleanly
 
@@ -27,23 +27,6 @@ PARAMS = """\
     preset: tennis_racket
     integrator: rk4
 """
-
-
-def nanoseconds(msg):
-    """Return the header stamp as an integer count of ns; float seconds since 1970 keep 0.2 us."""
-    return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
-
-
-def relative(msgs, start_ns):
-    """Odometry messages with stamps made relative to the body's start (its inertia stamp)."""
-    out = []
-    for m in msgs:
-        copy = Odometry()
-        copy.pose, copy.twist = m.pose, m.twist
-        copy.header.stamp.sec, copy.header.stamp.nanosec = divmod(nanoseconds(m) - start_ns,
-                                                                  1_000_000_000)
-        out.append(copy)
-    return out
 
 
 @pytest.mark.parametrize('threads', ['shared', 'per-body'])
@@ -60,7 +43,7 @@ def test_three_bodies_in_one_process(launch, probe, tmp_path, threads):
     for k in (1, 2, 3):
         probe.wait_for(f'/body{k}/odom', 20, timeout=30.0)
         probe.wait_for(f'/body{k}/inertia', 1)
-    start = {k: nanoseconds(inertia[k][0]) for k in (1, 2, 3)}
+    start = {k: time_ns(inertia[k][0].header.stamp) for k in (1, 2, 3)}
     rates = {k: (len(odom[k]) - 1) / (stamp(odom[k][-1]) - stamp(odom[k][0])) for k in odom}
     assert all(r == pytest.approx(50.0, rel=1e-6) for r in rates.values())  # 20 ms apart
     top, racket = presets.get('symmetric_top'), presets.get('tennis_racket')
@@ -80,9 +63,7 @@ def test_three_bodies_in_one_process(launch, probe, tmp_path, threads):
     command = WrenchStamped()
     command.wrench.torque.z = 0.5
     n1 = len(odom[1])
-    pub.publish(command)
-    probe.spin_until(lambda: applied and applied[-1].wrench.torque.z == 0.5, 10.0,
-                     'the torque on body 3')
+    probe.handshake(pub, command, lambda: applied and applied[-1].wrench.torque.z == 0.5)
     probe.spin_for(0.3)
     w3 = np.array([[m.twist.twist.angular.z] for m in odom[3][-5:]])
     assert np.all(w3 > top.omega0[2] + 1e-3)           # spun up about its axis
