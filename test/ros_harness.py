@@ -18,8 +18,7 @@ import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rigid_body_dynamics.nodes.conversions import quaternion_msg, status_values, time_msg
-from rigid_body_dynamics.nodes.conversions import time_ns
+from rigid_body_dynamics.nodes.conversions import quaternion_msg, status_values, time_msg, time_ns
 from rigid_body_dynamics.nodes.conversions import vector_msg
 
 #: Subscriber QoS for the tests: reliable with a deep queue, so nothing is dropped.
