@@ -6,7 +6,8 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 (``.venv/bin/pip install -r benchmarks/requirements-peers.txt``);
 ``--nodes`` measures the simulator node as a process (CPU, rates, latency);
 ``--only nodes`` skips the physics sections; ``--only soak | soak-rt | flood |
-bodies | hosts`` runs one reliability / scale measurement (see each script).
+bodies | hosts | analyzer-memory`` runs one reliability / scale measurement
+(see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
 run now are replaced.
@@ -44,7 +45,8 @@ def main():
     parser.add_argument('--peers', action='store_true', help='also MuJoCo and Basilisk')
     parser.add_argument('--nodes', action='store_true', help='also the simulator node')
     parser.add_argument('--only', choices=['nodes', 'soak', 'soak-rt', 'flood', 'bodies',
-                                           'hosts'], help='run only this section')
+                                           'hosts', 'analyzer-memory'],
+                        help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
     machine = common.machine()
@@ -94,6 +96,7 @@ SCALE = {
     'flood': ('flood', 'Torque-command flood: 10 kHz for 10 s'),
     'bodies': ('bodies', 'Many bodies on one machine'),
     'hosts': ('hosts', 'Several hosts: network namespaces on one machine'),
+    'analyzer-memory': ('analyzer_memory', 'Analyzer memory when fed faster than real time'),
 }
 
 
