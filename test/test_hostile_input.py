@@ -166,11 +166,11 @@ def test_analyzer_survives_hostile_odom(launch, probe):
         pub.publish(odom_msg(t[k], qk, wk))
         if k % 50 == 0:
             probe.spin_for(0.005)
-    # from the first handshake sample taken on nothing is lost (reliable, and both queues of
-    # 1000 are deeper than the burst); earlier handshake samples may have been
 
     def received():
         return int(probe.newest_status('input')[2]['messages received'])
+    # from the first handshake sample taken on nothing is lost (reliable, and both queues of
+    # 1000 are deeper than the burst); earlier handshake samples may have been
     probe.spin_until(lambda: received() >= t.size, 20.0, 'the analyzer to count the burst')
     assert received() <= t.size - 1 + shaken
     _, _, values = probe.newest_status('input')
