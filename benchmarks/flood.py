@@ -19,15 +19,12 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray
 from nav_msgs.msg import Odometry
-import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..', 'test'))
 from nodes import cpu_seconds, Process, script, sim  # noqa: E402, I100 (after the path set-up)
-from rigid_body_dynamics.nodes.conversions import quaternion_array  # noqa: E402
-from rigid_body_dynamics.nodes.conversions import vector_array  # noqa: E402
-from rigid_body_dynamics.physics import FreeRigidBody, presets, quaternions  # noqa: E402
-from ros_harness import Probe  # noqa: E402
+from rigid_body_dynamics.physics import presets  # noqa: E402
+from ros_harness import exact_errors, Probe  # noqa: E402
 
 RATE = 10_000
 SECONDS = 10.0
@@ -70,22 +67,6 @@ KINDS = ('valid body torque', 'non-finite torque', 'unknown frame_id')
 COUNTERS = ('accepted', 'rejected_non_finite', 'rejected_frame')
 
 
-def stamp(msg):
-    """Header stamp of a message (s)."""
-    return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
-
-
-def deviation(odom):
-    """Largest attitude (rad) and angular-velocity (rad/s) error against the exact free motion."""
-    body = presets.get(presets.DEFAULT)
-    t = np.array([stamp(m) for m in odom])
-    q = np.array([quaternion_array(m.pose.pose.orientation) for m in odom])
-    w = np.array([vector_array(m.twist.twist.angular) for m in odom])
-    q_ref, w_ref = FreeRigidBody(body.moments, body.omega0, body.q0).state_at(t)
-    return (float(np.max(quaternions.angle_between(q, q_ref))),
-            float(np.max(np.abs(w - w_ref))))
-
-
 def flood(probe, kind):
     """One flood; returns a row of measurements."""
     probe.messages['/diagnostics'].clear()
@@ -120,7 +101,9 @@ def flood(probe, kind):
         missed_key = next(k for k in integ1[2] if k.startswith('missed deadlines'))
         missed = int(integ1[2][missed_key]) - int(integ0[2][missed_key])
         achieved = float(integ1[2]['achieved real-time factor'])
-        error = deviation(odom[n0:]) if kind != 'valid body torque' else None
+        body = presets.get(presets.DEFAULT)
+        error = (exact_errors(odom[n0:], body.moments, body.omega0, body.q0)
+                 if kind != 'valid body torque' else None)
         alive = simulator.proc.poll() is None
     finally:
         if flooder is not None:

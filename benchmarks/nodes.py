@@ -16,7 +16,6 @@ import textwrap
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -24,7 +23,7 @@ from rigid_body_dynamics.nodes.conversions import status_values
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..', 'test'))
-from ros_harness import interrupt, Probe  # noqa: E402
+from ros_harness import command_round_trips, interrupt, Probe  # noqa: E402
 
 SIM = [sys.executable, '-m', 'rigid_body_dynamics.nodes.simulator', '--ros-args']
 ANALYZER = [sys.executable, '-m', 'rigid_body_dynamics.nodes.analyzer', '--ros-args']
@@ -159,26 +158,11 @@ def latency(cmd, commands=200, period=0.05):
 
 
 def _latency(cmd, probe, commands, period):
-    arrivals = {}
-    probe.node.create_subscription(
-        WrenchStamped, 'applied_torque',
-        lambda m: arrivals.setdefault(round(m.wrench.torque.x * 1e6), time.monotonic()),
-        QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
     proc = Process(cmd)
     try:
-        pub = probe.publisher(WrenchStamped, 'torque_cmd')
-        probe.spin_for(2.0)
-        sent = {}
-        for k in range(1, commands + 1):
-            msg = WrenchStamped()
-            msg.wrench.torque.x = k * 1e-6
-            sent[k] = time.monotonic()
-            pub.publish(msg)
-            probe.spin_for(period)
-        probe.spin_for(0.5)
+        return np.array(command_round_trips(probe, commands, period))
     finally:
         proc.close()
-    return np.array([arrivals[k] - sent[k] for k in sent if k in arrivals])
 
 
 def measure(quick=False):

@@ -13,16 +13,10 @@ stdout: the analyzer's statuses, the odom rate and the round-trip times (s).
 
 import argparse
 import json
-import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
-from rclpy.qos import QoSProfile, ReliabilityPolicy
-from ros_harness import Probe
-
-#: Torque per round-trip number (N m): small enough to leave the motion nearly free.
-TORQUE_UNIT = 1e-9
+from ros_harness import command_round_trips, Probe
 
 
 def analyzer_statuses(probe, timeout):
@@ -46,30 +40,6 @@ def odom_rate(probe, seconds=3.0):
     return (len(probe.messages['odom']) - before) / seconds
 
 
-def round_trips(probe, rounds, period):
-    """Seconds from publishing torque_cmd k to receiving applied_torque carrying it."""
-    arrivals = {}
-
-    def on_applied(msg):
-        key = 'hello' if msg.wrench.torque.y else round(msg.wrench.torque.x / TORQUE_UNIT)
-        arrivals.setdefault(key, time.monotonic())
-    probe.node.create_subscription(WrenchStamped, 'applied_torque', on_applied,
-                                   QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
-    pub = probe.publisher(WrenchStamped, 'torque_cmd')
-    hello = WrenchStamped()                            # until it comes back: matched both ways
-    hello.wrench.torque.y = TORQUE_UNIT
-    probe.handshake(pub, hello, lambda: 'hello' in arrivals)
-    sent = {}
-    for k in range(1, rounds + 1):
-        msg = WrenchStamped()
-        msg.wrench.torque.x = k * TORQUE_UNIT
-        sent[k] = time.monotonic()
-        pub.publish(msg)
-        probe.spin_for(period)
-    probe.spin_for(0.5)
-    return [arrivals[k] - sent[k] for k in sent if k in arrivals]
-
-
 def main():
     """Measure and print the JSON report."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[1])
@@ -89,7 +59,7 @@ def main():
         else:
             probe.wait_for('odom', 10, args.timeout)
         report['odom_rate'] = odom_rate(probe)
-        report['round_trips'] = round_trips(probe, args.rounds, args.period)
+        report['round_trips'] = command_round_trips(probe, args.rounds, args.period)
         report['rounds'] = args.rounds
     finally:
         probe.close()

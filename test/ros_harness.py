@@ -13,17 +13,22 @@ import subprocess
 import sys
 import time
 
+from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
+import numpy as np
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rigid_body_dynamics.nodes.conversions import quaternion_msg, status_values, time_msg, time_ns
-from rigid_body_dynamics.nodes.conversions import vector_msg
+from rigid_body_dynamics.nodes.conversions import quaternion_array, quaternion_msg, status_values
+from rigid_body_dynamics.nodes.conversions import time_msg, time_ns, vector_array, vector_msg
+from rigid_body_dynamics.physics import FreeRigidBody, quaternions
 
 #: Subscriber QoS for the tests: reliable with a deep queue, so nothing is dropped.
 DEEP = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10000,
                   reliability=ReliabilityPolicy.RELIABLE)
+#: Torque per round-trip number in ``command_round_trips`` (N m): leaves the motion nearly free.
+TORQUE_UNIT = 1e-9
 LATCHED = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                      reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -39,6 +44,38 @@ def interrupt(proc, timeout=10.0):
             proc.kill()
             proc.wait(5.0)
     return proc.returncode
+
+
+def stamp(msg):
+    """Header stamp in seconds."""
+    return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+
+
+def odom_arrays(msgs):
+    """(t, q, omega) arrays from Odometry messages."""
+    t = np.array([stamp(m) for m in msgs])
+    q = np.array([quaternion_array(m.pose.pose.orientation) for m in msgs])
+    w = np.array([vector_array(m.twist.twist.angular) for m in msgs])
+    return t, q, w
+
+
+def exact_errors(msgs, moments, omega0, q0=(0.0, 0.0, 0.0, 1.0)):
+    """
+    Largest errors of Odometry messages against the exact torque-free motion at their stamps.
+
+    Returns (attitude, rad; body rate, rad/s); stamps are simulated time from 0.
+    """
+    t, q, w = odom_arrays(msgs)
+    q_ref, w_ref = FreeRigidBody(moments, omega0, q0).state_at(t)
+    return (float(np.max(quaternions.angle_between(q, q_ref))),
+            float(np.max(np.abs(w - w_ref))))
+
+
+def assert_exact(msgs, moments, omega0, q0=(0.0, 0.0, 0.0, 1.0), tol=1e-9):
+    """Every Odometry message matches the exact torque-free motion: tol rad, tol |omega0|."""
+    attitude, rate = exact_errors(msgs, moments, omega0, q0)
+    assert attitude <= tol
+    assert rate <= tol * np.linalg.norm(omega0)
 
 
 def odom_msg(t, q, w):
@@ -76,6 +113,36 @@ def status_count(probe, name, key):
 def analyzer_heard(probe):
     """Tell whether the analyzer's diagnostics count any odom (needs /diagnostics subscribed)."""
     return status_count(probe, 'input', 'messages received') > 0
+
+
+def command_round_trips(probe, rounds, period):
+    """
+    Seconds from publishing torque_cmd k to receiving the simulator's applied_torque with it.
+
+    Command k carries k * TORQUE_UNIT about x; a first command (about y) is
+    repeated until it comes back, so none is lost to discovery. Commands that
+    never came back are left out (compare the count with ``rounds``).
+    """
+    arrivals = {}
+
+    def on_applied(msg):
+        key = 'hello' if msg.wrench.torque.y else round(msg.wrench.torque.x / TORQUE_UNIT)
+        arrivals.setdefault(key, time.monotonic())
+    probe.node.create_subscription(WrenchStamped, 'applied_torque', on_applied,
+                                   QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
+    pub = probe.publisher(WrenchStamped, 'torque_cmd')
+    hello = WrenchStamped()
+    hello.wrench.torque.y = TORQUE_UNIT
+    probe.handshake(pub, hello, lambda: 'hello' in arrivals)
+    sent = {}
+    for k in range(1, rounds + 1):
+        msg = WrenchStamped()
+        msg.wrench.torque.x = k * TORQUE_UNIT
+        sent[k] = time.monotonic()
+        pub.publish(msg)
+        probe.spin_for(period)
+    probe.spin_for(0.5)
+    return [arrivals[k] - sent[k] for k in sent if k in arrivals]
 
 
 class NodeProcess:

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 from rigid_body_dynamics.nodes.conversions import status_values, time_ns
 from rigid_body_dynamics.physics import presets
-from ros_harness import LATCHED, relative
+from ros_harness import assert_exact, LATCHED, relative, stamp
 from std_srvs.srv import SetBool
-from test_simulator_node import assert_exact, stamp, stop_cleanly
+from test_simulator_node import stop_cleanly
 
 FLEET = 'rigid_body_dynamics.nodes.fleet'
 PARAMS = """\

@@ -15,29 +15,16 @@ from nav_msgs.msg import Odometry
 import numpy as np
 from rcl_interfaces.srv import SetParameters
 from rclpy.parameter import Parameter
-from rigid_body_dynamics.nodes.conversions import quaternion_array
-from rigid_body_dynamics.nodes.conversions import vector_array
-from rigid_body_dynamics.physics import FreeRigidBody, quaternions
-from ros_harness import analyzer_heard, odom_msg, status_count
+from rigid_body_dynamics.physics import FreeRigidBody
+from ros_harness import analyzer_heard, assert_exact, odom_msg, stamp, status_count
 from std_srvs.srv import SetBool, Trigger
 
 SIM = 'rigid_body_dynamics.nodes.simulator'
 ANALYZER = 'rigid_body_dynamics.nodes.analyzer'
+#: The default body: moments (kg m^2) and initial body rate (rad/s).
+TOP = ((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
 BAD_VALUES = [math.nan, math.inf, -math.inf]
 BAD_FRAMES = ['map', 'x' * 100000, 'base_link ', '/odom', 'ödom', '\t']
-
-
-def stamp(msg):
-    return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
-
-
-def assert_free_motion(odom, moments=(1.0, 1.0, 1.5), omega0=(0.3, 0.0, 2.0)):
-    t = np.array([stamp(m) for m in odom])
-    q = np.array([quaternion_array(m.pose.pose.orientation) for m in odom])
-    w = np.array([vector_array(m.twist.twist.angular) for m in odom])
-    q_ref, w_ref = FreeRigidBody(moments, omega0).state_at(t)
-    assert np.max(quaternions.angle_between(q, q_ref)) < 1e-9
-    assert np.max(np.abs(w - w_ref)) < 1e-9
 
 
 @st.composite
@@ -87,7 +74,7 @@ def test_torque_flood_of_garbage_changes_nothing(launch, probe):
     assert sum(r.successful for r in client_results) == 150      # 1e9 Hz refused 50 times
     assert probe.call(SetBool, '/attitude_simulator/pause', SetBool.Request(data=False)).success
     probe.spin_until(lambda: len(odom) > n_before + 50, 20.0, 'publishing to go on')
-    assert_free_motion(odom)
+    assert_exact(odom, *TOP)
     t = np.array([stamp(m) for m in odom])
     assert np.all(np.diff(t) > 0.0)
     # commands are "latest wins": a flood overflows the subscriber's queue (depth 10) by
@@ -136,7 +123,7 @@ def test_services_while_paused_and_reset_storm(launch, probe):
     n = len(odom)
     probe.spin_until(lambda: len(odom) > n + 20, 10.0, 'motion after the storm')
     last_reset = max(i for i, m in enumerate(odom) if stamp(m) < 1e-6)
-    assert_free_motion(odom[last_reset:])
+    assert_exact(odom[last_reset:], *TOP)
     code, _ = proc.stop()
     assert code == 0
 
@@ -145,7 +132,7 @@ def test_analyzer_survives_hostile_odom(launch, probe):
     analyzer = launch(ANALYZER, '-p', 'inertia:=[1.0, 1.0, 1.5]', name='analyzer')
     probe.subscribe(DiagnosticArray, '/diagnostics')
     pub = probe.publisher(Odometry, 'odom', qos=1000)
-    body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    body = FreeRigidBody(*TOP)
     t = np.arange(0.0, 6.0, 0.01)
     q, w = body.state_at(t)
     # the first (good) sample until the analyzer counts it, so the burst is not lost in discovery

@@ -17,9 +17,9 @@ import pytest
 from rcl_interfaces.srv import SetParameters
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
-from rigid_body_dynamics.nodes.conversions import quaternion_array, time_ns, vector_array
+from rigid_body_dynamics.nodes.conversions import time_ns, vector_array
 from rigid_body_dynamics.physics import FreeRigidBody, Inertia, quaternions
-from ros_harness import LATCHED, relative, status_count
+from ros_harness import assert_exact, LATCHED, odom_arrays, relative, stamp, status_count
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import SetBool, Trigger
 
@@ -27,30 +27,9 @@ SIM = 'rigid_body_dynamics.nodes.simulator'
 NODE = '/attitude_simulator'
 
 
-def stamp(msg):
-    """Header stamp in seconds."""
-    return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
-
-
-def odom_arrays(msgs):
-    """(t, q, omega) arrays from Odometry messages."""
-    t = np.array([stamp(m) for m in msgs])
-    q = np.array([quaternion_array(m.pose.pose.orientation) for m in msgs])
-    w = np.array([vector_array(m.twist.twist.angular) for m in msgs])
-    return t, q, w
-
-
 def vectors(msgs):
     """(t, v) arrays from Vector3Stamped messages."""
     return np.array([stamp(m) for m in msgs]), np.array([vector_array(m.vector) for m in msgs])
-
-
-def assert_exact(msgs, moments, omega0, q0=(0.0, 0.0, 0.0, 1.0), tol=1e-9):
-    """Every Odometry message matches the exact torque-free motion at its stamp."""
-    t, q, w = odom_arrays(msgs)
-    q_ref, w_ref = FreeRigidBody(moments, omega0, q0).state_at(t)
-    assert np.max(quaternions.angle_between(q, q_ref)) <= tol
-    assert np.max(np.abs(w - w_ref)) <= tol * np.linalg.norm(omega0)
 
 
 def set_params(probe, **values):
@@ -317,7 +296,11 @@ def test_thread_priority_is_applied_or_refused_with_the_reason(launch, probe):
     """SCHED_FIFO for the integration thread: used where allowed, a warning where not."""
     proc = launch(SIM, '-p', 'thread_priority:=100', name='bad_priority')
     assert proc.wait(20.0) == 1
-    assert 'thread_priority must be an integer from 0 to 99' in proc.output()
+    assert 'thread_priority out of range. Min: 0, Max: 99' in proc.output()
+    proc = launch(SIM, '-p', 'thread_priority:=2.5', name='float_priority')
+    assert proc.wait(20.0) == 1
+    assert "'thread_priority' to '2.5' of type 'DOUBLE', expecting type 'INTEGER'" in \
+        proc.output()
     proc = launch(SIM, '-p', 'thread_priority:=10', name='priority')
     odom = probe.subscribe(Odometry, 'odom')
     probe.wait_for('odom', 20)

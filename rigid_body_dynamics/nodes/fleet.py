@@ -104,12 +104,12 @@ class Fleet:
             node.publish_diagnostics()
 
     def start(self):
-        """Start stepping the bodies."""
-        sys.setswitchinterval(SWITCH_INTERVAL)
+        """Start stepping the bodies; with a thread each, every body sets the GIL interval."""
         if not self.shared:
             for node in self.nodes:
                 node.start()
             return
+        sys.setswitchinterval(SWITCH_INTERVAL)
         self._pending = collections.deque()   # (node, snapshot or None = diagnostics)
         self._outbox = []
         self._next_diagnostics = time.monotonic() + DIAGNOSTIC_PERIOD

@@ -9,7 +9,8 @@ then checked here, with a reason for every refusal.
 
 import math
 
-from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rcl_interfaces.msg import SetParametersResult
 
 
 class ConfigurationError(ValueError):
@@ -17,12 +18,19 @@ class ConfigurationError(ValueError):
 
 
 def descriptor(description, read_only=False, low=None, high=None, constraints='',
-               dynamic_typing=False):
-    """Build a ParameterDescriptor: description (with units), optional range, constraints."""
+               dynamic_typing=False, integer=False):
+    """
+    Build a ParameterDescriptor: description (with units), optional range, constraints.
+
+    The range [low, high] is a floating-point one, or an integer one with
+    ``integer=True``; rclpy refuses values outside it, also at start-up.
+    """
     desc = ParameterDescriptor(description=description, read_only=read_only,
                                additional_constraints=constraints,
                                dynamic_typing=dynamic_typing)
-    if low is not None:
+    if low is not None and integer:
+        desc.integer_range = [IntegerRange(from_value=int(low), to_value=int(high), step=1)]
+    elif low is not None:
         desc.floating_point_range = [FloatingPointRange(from_value=float(low),
                                                         to_value=float(high), step=0.0)]
     return desc

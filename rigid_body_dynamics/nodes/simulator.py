@@ -140,10 +140,6 @@ class AttitudeSimulator(Node):
                         self.get_parameter('body_frame').value)
         self._publish_clock = self.get_parameter('publish_clock').value
         self.thread_priority = self.get_parameter('thread_priority').value
-        if isinstance(self.thread_priority, bool) or not isinstance(self.thread_priority, int) \
-                or not 0 <= self.thread_priority <= 99:
-            raise ConfigurationError('thread_priority must be an integer from 0 to 99, got '
-                                     f'{self.thread_priority!r}')
         rate = as_float('integration_rate', self.get_parameter('integration_rate').value,
                         1e-6, 1e5)
         self._rate = rate
@@ -229,7 +225,7 @@ class AttitudeSimulator(Node):
             'SCHED_FIFO priority (1-99) of the integration thread on Linux, for fewer missed '
             'deadlines on a loaded machine; 0 = normal scheduling. Needs CAP_SYS_NICE or an '
             'rtprio limit (limits.conf); if refused, the node says so and runs normally.',
-            read_only=True, constraints='integer, 0 (off) or 1 to 99'))
+            read_only=True, low=0, high=99, integer=True))
         self.declare_parameter('publish_imu', True, descriptor(
             'Also publish sensor_msgs/Imu on imu (REP 145; no acceleration).', read_only=True))
 
