@@ -7,14 +7,12 @@ largest over samples every 1000 steps against the exact solution evaluated
 in one shot from t = 0.
 """
 
-import math
 import time
 
 from common import errors, fmt
 import numpy as np
 from rigid_body_dynamics.physics import make_integrator
 from rigid_body_dynamics.physics.equations import state_rhs
-from rigid_body_dynamics.physics.free_motion import BodyShape
 from scipy.integrate import solve_ivp
 
 MOMENTS = (1.0, 2.0, 3.0)
@@ -40,27 +38,6 @@ def run_stepper(name, dt, steps, sample=1000):
     return elapsed / (sample * (n_samples - 1)), errors(MOMENTS, OMEGA0, Q0, t, q, w)
 
 
-def run_composed_exact(dt, steps, sample=1000):
-    """Restart the exact flow at every step (as under torque): round-off accumulation."""
-    shape = BodyShape(MOMENTS)
-    q, m = Q0, tuple(i * w for i, w in zip(MOMENTS, OMEGA0))
-    n_samples = steps // sample + 1
-    ts = np.arange(n_samples) * sample * dt
-    qs = np.empty((n_samples, 4))
-    ws = np.empty((n_samples, 3))
-    qs[0], ws[0] = Q0, OMEGA0
-    start = time.perf_counter()
-    for k in range(1, n_samples):
-        for _ in range(sample):
-            q, m = shape.flow(q, m).state(dt)
-            r = 1.0 / math.sqrt(sum(c * c for c in q))
-            q = tuple(c * r for c in q)
-        qs[k] = q
-        ws[k] = [mi / i for mi, i in zip(m, MOMENTS)]
-    elapsed = time.perf_counter() - start
-    return elapsed / steps, errors(MOMENTS, OMEGA0, Q0, ts, qs, ws)
-
-
 def run_solve_ivp(method, rtol, atol, duration, sample_dt):
     """One solve_ivp call over the span; returns (seconds per simulated second, errors)."""
     t_eval = np.arange(0.0, duration + 0.5 * sample_dt, sample_dt)
@@ -78,13 +55,10 @@ def measure(steps):
     rows = []
     duration = steps * 1e-3
     ref_cost, ref_err = run_solve_ivp('RK45', 1e-3, 1e-6, duration, 1.0)
-    for name in ('exact', 'exact4', 'rk4', 'dop853'):
+    for name in ('exact', 'rk4'):
         per_step, err = run_stepper(name, 1e-3, steps)
         per_step_10, _ = run_stepper(name, 1e-2, max(steps // 100, 2000))
         rows.append((name, per_step * 1e6, per_step * 1e3, per_step_10 * 1e2, err))
-    per_step, err = run_composed_exact(1e-3, min(steps, 100000))
-    rows.append(('exact, flow restarted every step (as under torque; 1e5 steps)', per_step * 1e6,
-                 per_step * 1e3, None, err))
     table_rows = []
     for name, us, sec1, sec10, err in rows:
         sec10 = 'n/a' if sec10 is None else f'{sec10:.5f}'

@@ -94,9 +94,7 @@ def basilisk_run(integrator):
 def measure():
     """Rows for the peer table, ours first; a peer that is not installed is said so."""
     runs = [('rigid_body_dynamics exact', lambda: ours('exact')),
-            ('rigid_body_dynamics exact4', lambda: ours('exact4')),
             ('rigid_body_dynamics rk4', lambda: ours('rk4')),
-            ('rigid_body_dynamics dop853', lambda: ours('dop853')),
             ('MuJoCo, default (Euler)', lambda: mujoco_run('Euler')),
             ('MuJoCo, RK4', lambda: mujoco_run('RK4')),
             ('MuJoCo, implicitfast', lambda: mujoco_run('implicitfast')),

@@ -30,7 +30,7 @@ def generate_launch_description():
                               description='simulated seconds per wall second; 0 = as fast '
                                           'as possible'),
         DeclareLaunchArgument('integrator', default_value='exact',
-                              description='exact, exact4, rk4 or dop853'),
+                              description='exact or rk4'),
         DeclareLaunchArgument('publish_clock', default_value='false',
                               description='publish /clock from the simulator'),
         DeclareLaunchArgument('marker_scale', default_value='1.0',

@@ -205,6 +205,11 @@ class Inertia:
             return 'spherical'
         return 'asymmetric' if self.symmetry_axis is None else 'axisymmetric'
 
+    @property
+    def is_principal_frame(self):
+        """Return True when the body frame is the principal frame (no rotation between them)."""
+        return self._identity
+
     # Frame changes. Vectors (..., 3), quaternions (..., 4) scalar-last.
     def to_principal(self, v_body):
         """Body-frame vector components -> principal-frame components."""

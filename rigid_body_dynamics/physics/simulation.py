@@ -75,39 +75,50 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     stepper = make_integrator(integrator, inertia.moments, dt,
                               inertia.attitude_to_principal(q0 / np.linalg.norm(q0)),
                               inertia.to_principal(np.asarray(omega0, dtype=float)))
-    body_const = np.zeros(3) if torque is None or callable(torque) else \
-        np.asarray(torque, dtype=float).reshape(3)
-    principal_const = tuple(float(c) for c in inertia.to_principal(body_const))
-    rows = n // every + 1
+    if callable(torque):
+        user_torque = torque
+    else:
+        body_const = np.zeros(3) if torque is None else np.asarray(torque, dtype=float).reshape(3)
+        principal_const = tuple(float(c) for c in inertia.to_principal(body_const))
     report_every = max(1, n // 100)
-    t = np.empty(rows)
-    q = np.empty((rows, 4))
-    w = np.empty((rows, 3))
-    tau = np.empty((rows, 3))
-    work = np.empty(rows)
-    imp = np.empty((rows, 3))
+    t, q, w, tau, work, imp = [], [], [], [], [], []
+    step = stepper.step
     for k in range(n + 1):
         if callable(torque):
-            tb = np.asarray(torque(stepper.time, *_user_state(inertia, stepper)),
-                            dtype=float).reshape(3)
-            tp = tuple(float(c) for c in inertia.to_principal(tb))
+            tb = user_torque(stepper.time, *_user_state(inertia, stepper))
+            tp = _principal(inertia, tb, stepper.time)
         else:
             tb, tp = body_const, principal_const
         if k % every == 0:
-            r = k // every
-            t[r] = stepper.time
-            q[r] = stepper.q
-            w[r] = stepper.omega
-            tau[r] = tb
-            work[r] = stepper.work
-            imp[r] = stepper.impulse
+            t.append(stepper.time)
+            q.append(stepper.q)
+            w.append(stepper.omega)
+            tau.append(tb)
+            work.append(stepper.work)
+            imp.append(stepper.impulse)
         if k < n:
-            stepper.step(tp)
+            step(tp)
         if progress is not None and (k % report_every == 0 or k == n):
             progress(k / max(n, 1))
-    q_user = inertia.attitude_to_body(q)
-    return SimulationResult(t=t, q=q_user, omega=inertia.to_body(w), torque=tau, work=work,
-                            impulse=imp, inertia=inertia, integrator=integrator)
+    tau = np.array(tau, dtype=float).reshape(-1, 3)
+    return SimulationResult(t=np.array(t), q=inertia.attitude_to_body(np.array(q)),
+                            omega=inertia.to_body(np.array(w)), torque=tau,
+                            work=np.array(work), impulse=np.array(imp).reshape(-1, 3),
+                            inertia=inertia, integrator=integrator)
+
+
+def _principal(inertia, torque_body, t):
+    """Return a user's body torque (N m) as a principal-frame tuple; ValueError if bad."""
+    try:
+        values = tuple(float(c) for c in np.asarray(torque_body, dtype=float).reshape(3))
+    except (TypeError, ValueError):
+        raise ValueError(f'torque(t={t!r}) must return three numbers (N m), '
+                         f'got {torque_body!r}') from None
+    if not all(math.isfinite(c) for c in values):
+        raise ValueError(f'torque(t={t!r}) returned a non-finite torque {values}')
+    if inertia.is_principal_frame:
+        return values
+    return tuple(float(c) for c in inertia.to_principal(np.array(values)))
 
 
 def _user_state(inertia, stepper):

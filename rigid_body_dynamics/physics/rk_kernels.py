@@ -1,0 +1,150 @@
+"""
+Explicit Runge-Kutta steps of the rigid body, unrolled from Butcher tableaux.
+
+The system is Euler's equations (4.26) with a torque held over the step and
+the quaternion kinematics dq/dt = q (x) (omega, 0) / 2, seven float states
+(omega body rad/s, q x-y-z-w body -> world). A step in pure Python costs what
+its arithmetic costs only when every stage is written out as scalar
+statements; writing them by hand for a 12-stage tableau invites typos, so the
+statements are generated here from the tableau (as ``collections.namedtuple``
+generates its class) and compiled once at import. The tableaux:
+
+- ``RK4``: the classic fourth-order method (4 stages).
+- ``BUTCHER6``: Butcher's 7-stage method of order 6 (rational coefficients;
+  J. C. Butcher, Numerical Methods for ODEs, 2nd ed., section 325).
+- ``DOP853``: the 12-stage order-8 formula of Dormand and Prince's DOP853,
+  its coefficients taken from scipy (``scipy.integrate._ivp.dop853_coefficients``),
+  without the error estimator or dense output.
+
+Each kernel is ``step(inv, q, w, h, tau, tau_world)`` with ``inv`` = (c1, c2,
+c3, 1/I1, 1/I2, 1/I3), c1 = (I2 - I3) / I1 and cyclic, ``tau`` the body torque
+(N m) and ``tau_world`` the world torque (N m) held fixed in the world frame
+(rotated into the body at every stage). It returns (q, omega, work): q
+renormalised, and the step's work int omega . tau dt (J) by the method's own
+quadrature of the stage values, so it is accurate to the method's order.
+Three variants: ``free`` (no torque; work 0), ``body`` (tau only) and
+``world`` (tau plus tau_world).
+"""
+
+from fractions import Fraction as F
+
+from scipy.integrate._ivp import dop853_coefficients as _dop
+
+#: The classic RK4 tableau (A lower triangular rows, b).
+RK4 = (((), (F(1, 2),), (F(0), F(1, 2)), (F(0), F(0), F(1))),
+       (F(1, 6), F(1, 3), F(1, 3), F(1, 6)))
+
+#: Butcher's order-6 tableau (A lower triangular rows, b).
+BUTCHER6 = (
+    ((),
+     (F(1, 3),),
+     (F(0), F(2, 3)),
+     (F(1, 12), F(1, 3), F(-1, 12)),
+     (F(-1, 16), F(9, 8), F(-3, 16), F(-3, 8)),
+     (F(0), F(9, 8), F(-3, 8), F(-3, 4), F(1, 2)),
+     (F(9, 44), F(-9, 11), F(63, 44), F(18, 11), F(0), F(-16, 11))),
+    (F(11, 120), F(0), F(27, 40), F(27, 40), F(-4, 15), F(-4, 15), F(11, 120)),
+)
+
+#: DOP853's order-8 tableau (12 stages) as floats.
+DOP853 = (
+    tuple(tuple(float(a) for a in _dop.A[i, :i]) for i in range(_dop.N_STAGES)),
+    tuple(float(b) for b in _dop.B),
+)
+
+_OMEGA = ('wx', 'wy', 'wz')
+_QUAT = ('qx', 'qy', 'qz', 'qw')
+
+
+def _lit(coefficient):
+    return repr(float(coefficient))
+
+
+def _derivative_lines(i, mode):
+    """Scaled derivatives h f(stage i): dwx{i} ... dqw{i}, and the stage torque."""
+    wx, wy, wz, qx, qy, qz, qw = (f'{n}{i}' for n in _OMEGA + _QUAT)
+    lines = []
+    if mode == 'world':
+        # tau_b = tau + R(q)^T tau_world: rotate by the conjugate (-qx, -qy, -qz, qw)
+        lines += [
+            f'    ux = 2.0 * (-{qy} * gz + {qz} * gy)',
+            f'    uy = 2.0 * (-{qz} * gx + {qx} * gz)',
+            f'    uz = 2.0 * (-{qx} * gy + {qy} * gx)',
+            f'    tx{i} = tbx + gx + {qw} * ux - {qy} * uz + {qz} * uy',
+            f'    ty{i} = tby + gy + {qw} * uy - {qz} * ux + {qx} * uz',
+            f'    tz{i} = tbz + gz + {qw} * uz - {qx} * uy + {qy} * ux',
+            f'    dwx{i} = hc1 * {wy} * {wz} + hj1 * tx{i}',
+            f'    dwy{i} = hc2 * {wz} * {wx} + hj2 * ty{i}',
+            f'    dwz{i} = hc3 * {wx} * {wy} + hj3 * tz{i}',
+        ]
+    elif mode == 'body':
+        lines += [f'    dwx{i} = hc1 * {wy} * {wz} + ht1',
+                  f'    dwy{i} = hc2 * {wz} * {wx} + ht2',
+                  f'    dwz{i} = hc3 * {wx} * {wy} + ht3']
+    else:
+        lines += [f'    dwx{i} = hc1 * {wy} * {wz}',
+                  f'    dwy{i} = hc2 * {wz} * {wx}',
+                  f'    dwz{i} = hc3 * {wx} * {wy}']
+    lines += [
+        f'    dqx{i} = hh * ({qw} * {wx} + {qy} * {wz} - {qz} * {wy})',
+        f'    dqy{i} = hh * ({qw} * {wy} + {qz} * {wx} - {qx} * {wz})',
+        f'    dqz{i} = hh * ({qw} * {wz} + {qx} * {wy} - {qy} * {wx})',
+        f'    dqw{i} = -hh * ({qx} * {wx} + {qy} * {wy} + {qz} * {wz})',
+    ]
+    return lines
+
+
+def kernel_source(tableau, mode, name='step'):
+    """Python source of one unrolled step for ``tableau`` = (A rows, b) and ``mode``."""
+    rows, weights = tableau
+    lines = [f'def {name}(inv, q, w, h, tau, tau_world):',
+             '    c1, c2, c3, j1, j2, j3 = inv',
+             '    qx0, qy0, qz0, qw0 = q',
+             '    wx0, wy0, wz0 = w',
+             '    hh = 0.5 * h',
+             '    hc1, hc2, hc3 = h * c1, h * c2, h * c3']
+    if mode == 'body':
+        lines += ['    tbx, tby, tbz = tau',
+                  '    ht1, ht2, ht3 = h * tbx * j1, h * tby * j2, h * tbz * j3']
+    elif mode == 'world':
+        lines += ['    tbx, tby, tbz = tau',
+                  '    gx, gy, gz = tau_world',
+                  '    hj1, hj2, hj3 = h * j1, h * j2, h * j3']
+    for i, row in enumerate(rows):
+        if i > 0:
+            for var in _OMEGA + _QUAT:
+                terms = ' + '.join(f'{_lit(a)} * d{var}{j}' for j, a in enumerate(row) if a != 0)
+                lines.append(f'    {var}{i} = {var}0 + {terms}' if terms else
+                             f'    {var}{i} = {var}0')
+        lines += _derivative_lines(i, mode)
+    used = [(j, b) for j, b in enumerate(weights) if b != 0]
+    for var in _OMEGA + _QUAT:
+        terms = ' + '.join(f'{_lit(b)} * d{var}{j}' for j, b in used)
+        lines.append(f'    {var} = {var}0 + ({terms})')
+    lines.append('    r = (qx * qx + qy * qy + qz * qz + qw * qw) ** -0.5')
+    if mode == 'free':
+        lines.append('    work = 0.0')
+    else:
+        # work = h sum_i b_i omega_i . tau_i
+        if mode == 'body':
+            power = [f'{_lit(b)} * (wx{j} * tbx + wy{j} * tby + wz{j} * tbz)' for j, b in used]
+        else:
+            power = [f'{_lit(b)} * (wx{j} * tx{j} + wy{j} * ty{j} + wz{j} * tz{j})'
+                     for j, b in used]
+        lines.append('    work = h * (' + ' + '.join(power) + ')')
+    lines.append('    return (qx * r, qy * r, qz * r, qw * r), (wx, wy, wz), work')
+    return '\n'.join(lines) + '\n'
+
+
+def compile_kernel(tableau, mode):
+    """Compile :func:`kernel_source` into a function."""
+    namespace = {}
+    code = compile(kernel_source(tableau, mode), f'<rk kernel {mode}>', 'exec')
+    exec(code, namespace)  # noqa: S102 (source generated above from the tableau only)
+    return namespace['step']
+
+
+#: Kernels by (order, mode).
+KERNELS = {(order, mode): compile_kernel(tableau, mode)
+           for order, tableau in ((4, RK4), (6, BUTCHER6), (8, DOP853))
+           for mode in ('free', 'body', 'world')}
