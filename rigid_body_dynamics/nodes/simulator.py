@@ -41,6 +41,7 @@ from .parameters import as_float, as_vector, check_change, ConfigurationError, d
 from .runner import run
 from .throttle import ThrottledWarnings
 from ..physics import Inertia, INTEGRATORS, make_integrator, presets, quaternions
+from ..physics.integrators import REMOVED as REMOVED_INTEGRATORS
 
 NODE_NAME = 'attitude_simulator'
 _ZERO = (0.0, 0.0, 0.0)
@@ -254,9 +255,9 @@ class AttitudeSimulator(Node):
         out['initial_angular_velocity'] = as_vector(
             'initial_angular_velocity', values['initial_angular_velocity'], 3)
         if values['integrator'] not in INTEGRATORS:
-            raise ConfigurationError(
+            raise ConfigurationError(REMOVED_INTEGRATORS.get(values['integrator']) or (
                 f'unknown integrator {values["integrator"]!r}; choose one of '
-                f'{", ".join(sorted(INTEGRATORS))}')
+                f'{", ".join(sorted(INTEGRATORS))}'))
         rate = getattr(self, '_rate', None) or as_float(
             'integration_rate', self.get_parameter('integration_rate').value, 1e-6, 1e5)
         out['publish_rate'] = as_float('publish_rate', values['publish_rate'], 1e-6, rate)
