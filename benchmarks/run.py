@@ -5,7 +5,8 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 ``--peers`` adds MuJoCo and Basilisk if installed
 (``.venv/bin/pip install -r benchmarks/requirements-peers.txt``);
 ``--nodes`` measures the simulator node as a process (CPU, rates, latency);
-``--only nodes`` skips the physics sections; ``--only soak | soak-rt | flood |
+``--only nodes`` skips the physics sections; ``--only torque`` runs the
+torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak | soak-rt | flood |
 bodies | hosts | analyzer-memory`` runs one reliability / scale measurement
 (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
@@ -44,15 +45,17 @@ def main():
     parser.add_argument('--quick', action='store_true', help='1e5 steps instead of 1e6')
     parser.add_argument('--peers', action='store_true', help='also MuJoCo and Basilisk')
     parser.add_argument('--nodes', action='store_true', help='also the simulator node')
-    parser.add_argument('--only', choices=['nodes', 'soak', 'soak-rt', 'flood', 'bodies',
-                                           'hosts', 'analyzer-memory'],
+    parser.add_argument('--only', choices=['nodes', 'torque', 'soak', 'soak-rt', 'flood',
+                                           'bodies', 'hosts', 'analyzer-memory'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
     machine = common.machine()
     sections = {}
 
-    if args.only in ('soak', 'soak-rt'):
+    if args.only == 'torque':
+        torque_section(sections, machine, args.peers)
+    elif args.only in ('soak', 'soak-rt'):
         soak_section(sections, machine, real_time=args.only == 'soak-rt')
     elif args.only in SCALE:
         scale_section(sections, machine, args.only)
@@ -126,6 +129,27 @@ def node_section(sections, machine, quick):
     sections['nodes'] = '\n'.join(header + lines)
 
 
+def torque_section(sections, machine, with_peers):
+    """Accuracy against cost under a held torque (T1, T2), with the peers if asked."""
+    print('under torque ...', flush=True)
+    tables = torque.measure(peers=with_peers)
+    body = ['## Under a held torque: accuracy against cost', '',
+            f'Measured {machine}.', '', torque.__doc__.strip().replace('\n', ' ')]
+    for case, rows in tables.items():
+        body += ['', f'### {case}', '',
+                 common.table(['method', 'dt (ms)', 'attitude (rad, max)',
+                               'omega (rel., max)', 'ms per sim. s',
+                               'cost / plain RK4 at 1 ms', 'T - T0 - W (rel.)'], rows)]
+        cost = {(row[0], row[1]): float(row[4]) for row in rows if row[4]}
+        ratio = cost[('ours `exact`', '1')] / cost[('ours `rk4`', '1')]
+        body += ['', f'Per step at 1 ms, `exact` costs {ratio:.2f}x our `rk4`.']
+        basilisk = cost.get(('Basilisk 2.12.1 RKF78', '10'))
+        if basilisk:
+            body[-1] += (f' At 10 ms `exact` costs 1/{basilisk / cost[("ours `exact`", "10")]:.0f}'
+                         ' of Basilisk RKF78 at 10 ms.')
+    sections['physics-torque'] = '\n'.join(body)
+
+
 def physics_sections(sections, steps, machine, with_peers):
     """Accuracy, torque and (optionally) peer sections."""
     print(f'accuracy and cost, {steps} steps per integrator ...', flush=True)
@@ -149,16 +173,7 @@ def physics_sections(sections, steps, machine, with_peers):
         'torque section, measured against an independent reference.',
     ])
 
-    print('under torque ...', flush=True)
-    tables = torque.measure(peers=with_peers)
-    body = ['## Under a held torque: accuracy against cost', '',
-            f'Measured {machine}.', '', torque.__doc__.strip().replace('\n', ' ')]
-    for case, rows in tables.items():
-        body += ['', f'### {case}', '',
-                 common.table(['method', 'dt (ms)', 'attitude (rad, max)',
-                               'omega (rel., max)', 'ms per sim. s',
-                               'cost / plain RK4 at 1 ms', 'T - T0 - W (rel.)'], rows)]
-    sections['physics-torque'] = '\n'.join(body)
+    torque_section(sections, machine, with_peers)
 
     if with_peers:
         print('peers ...', flush=True)

@@ -17,7 +17,7 @@ relative to the run's largest |omega_ref| (T2 settles to rest, where a
 pointwise relative error means nothing). Cost is wall time per simulated
 second, also as a ratio to a plain pure-Python RK4 (``plain_rk4``, the
 textbook code a user would write) at 1 ms measured in the same run, the unit
-of issue 10; each cost is the least of three runs (two for the peers). The
+of issue 10; each cost is the least of five runs (two for the peers). The
 balance column is max |T - T0 - W| / T0 of our steppers (W is the stepper's
 quadrature of omega . tau, not a by-construction quantity).
 
@@ -231,7 +231,7 @@ def _best(run, repeats):
     return best
 
 
-def measure(peers=False, repeats=3, progress=print):
+def measure(peers=False, repeats=5, progress=print):
     """
     Measure both cases; returns {case: rows}.
 

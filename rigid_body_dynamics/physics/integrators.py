@@ -241,13 +241,18 @@ class ExactIntegrator(Integrator):
         if not hasattr(self, '_shape'):
             self._shape = BodyShape(self.moments)
             self._i_min = min(self.moments)
+            self._order6_rate = self.ORDER6_LIMIT / self.dt   # rho (1/s) up to which order 6
         self._segment = None
+        self._torque_key = None        # the torque whose time scale is cached below
+        self._torque_rate = 0.0        # sqrt(max |tau_i| / I_min), 1/s
 
     def _free_step(self):
         if self._segment is None:
             flow = self._shape.flow(self.q, self.angular_momentum_body)
             self._segment = None if flow.near_separatrix else (flow, self.steps)
         if self._segment is None:
+            self._torque_rate = 0.0
+            self._torque_key = None
             self._rk('free', None, None)
             return
         flow, start = self._segment
@@ -259,25 +264,28 @@ class ExactIntegrator(Integrator):
 
     def _torque_step(self, torque, torque_world):
         self._segment = None
+        key = (torque, torque_world)
+        if key != self._torque_key:
+            largest = max(abs(torque[0]), abs(torque[1]), abs(torque[2]))
+            if torque_world is not None:
+                largest += max(abs(torque_world[0]), abs(torque_world[1]),
+                               abs(torque_world[2]))
+            self._torque_rate = math.sqrt(largest / self._i_min)
+            self._torque_key = key
         return self._rk('body' if torque_world is None else 'world', torque, torque_world)
 
     def _rk(self, mode, torque, torque_world):
         """Advance by dt with the order-6 or order-8 kernel of ``mode``; return the work (J)."""
         wx, wy, wz = self.omega
-        rho = math.sqrt(wx * wx + wy * wy + wz * wz)
-        if torque is not None:
-            largest = max(abs(torque[0]), abs(torque[1]), abs(torque[2]))
-            if torque_world is not None:
-                largest += max(abs(torque_world[0]), abs(torque_world[1]), abs(torque_world[2]))
-            rho += math.sqrt(largest / self._i_min)
-        h = self.dt
-        order6, order8 = self._kernels[mode]
-        if rho * h <= self.ORDER6_LIMIT:
-            self.q, self.omega, work = order6(self._inv, self.q, self.omega, h, torque,
-                                              torque_world)
+        spare = self._order6_rate - self._torque_rate     # what |omega| may be for order 6
+        if spare > 0.0 and wx * wx + wy * wy + wz * wz <= spare * spare:
+            self.q, self.omega, work = self._kernels[mode][0](
+                self._inv, self.q, self.omega, self.dt, torque, torque_world)
             return work
-        n = max(1, math.ceil(rho * h / self.ORDER8_LIMIT))
-        h /= n
+        rho = math.sqrt(wx * wx + wy * wy + wz * wz) + self._torque_rate
+        n = max(1, math.ceil(rho * self.dt / self.ORDER8_LIMIT))
+        h = self.dt / n
+        order8 = self._kernels[mode][1]
         q, w, work = self.q, self.omega, 0.0
         for _ in range(n):
             q, w, dw = order8(self._inv, q, w, h, torque, torque_world)
