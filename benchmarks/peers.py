@@ -38,19 +38,41 @@ def ours(name):
     return (time.perf_counter() - start) / DURATION, np.array(t), np.array(q), np.array(w)
 
 
-def mujoco_run(integrator):
-    """Run MuJoCo: free joint, zero gravity, diagonal inertia; qvel[3:6] is the body rate."""
+def mujoco_body(moments, omega0, dt, integrator):
+    """(mujoco, model, data): one free body, zero gravity, diagonal inertia, body rate omega0."""
     import mujoco
     xml = f"""
     <mujoco>
-      <option gravity="0 0 0" timestep="{DT}" integrator="{integrator}"/>
+      <option gravity="0 0 0" timestep="{dt}" integrator="{integrator}"/>
       <worldbody><body><freejoint/>
-        <inertial pos="0 0 0" mass="1" diaginertia="{MOMENTS[0]} {MOMENTS[1]} {MOMENTS[2]}"/>
+        <inertial pos="0 0 0" mass="1" diaginertia="{moments[0]} {moments[1]} {moments[2]}"/>
       </body></worldbody>
     </mujoco>"""
     model = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(model)
-    data.qvel[3:6] = OMEGA0
+    data.qvel[3:6] = omega0
+    return mujoco, model, data
+
+
+def basilisk_body(moments, omega0, dt, integrator):
+    """(sim, craft): a Basilisk hub (MRP attitude) at rest attitude, body rate omega0."""
+    from Basilisk.simulation import spacecraft, svIntegrators
+    from Basilisk.utilities import macros, SimulationBaseClass
+    sim = SimulationBaseClass.SimBaseClass()
+    process = sim.CreateNewProcess('dynamics')
+    process.addTask(sim.CreateNewTask('step', macros.sec2nano(dt)))
+    craft = spacecraft.Spacecraft()
+    craft.hub.mHub = 1.0
+    craft.hub.IHubPntBc_B = [[moments[0], 0, 0], [0, moments[1], 0], [0, 0, moments[2]]]
+    craft.hub.sigma_BNInit = [[0.0], [0.0], [0.0]]
+    craft.hub.omega_BN_BInit = [[c] for c in omega0]
+    craft.setIntegrator(getattr(svIntegrators, integrator)(craft))
+    return sim, craft
+
+
+def mujoco_run(integrator):
+    """Run MuJoCo: free joint, zero gravity, diagonal inertia; qvel[3:6] is the body rate."""
+    mujoco, model, data = mujoco_body(MOMENTS, OMEGA0, DT, integrator)
     t, q, w = [0.0], [Q0], [OMEGA0]
     start = time.perf_counter()
     for k in range(STEPS):
@@ -65,18 +87,8 @@ def mujoco_run(integrator):
 
 def basilisk_run(integrator):
     """Run a Basilisk spacecraft hub (MRP attitude) with an RK4 or RKF78 integrator."""
-    from Basilisk.simulation import spacecraft, svIntegrators
-    from Basilisk.utilities import macros, RigidBodyKinematics, SimulationBaseClass
-    sim = SimulationBaseClass.SimBaseClass()
-    process = sim.CreateNewProcess('dynamics')
-    process.addTask(sim.CreateNewTask('step', macros.sec2nano(DT)))
-    craft = spacecraft.Spacecraft()
-    craft.hub.mHub = 1.0
-    craft.hub.IHubPntBc_B = [[MOMENTS[0], 0, 0], [0, MOMENTS[1], 0], [0, 0, MOMENTS[2]]]
-    craft.hub.sigma_BNInit = [[0.0], [0.0], [0.0]]
-    craft.hub.omega_BN_BInit = [[OMEGA0[0]], [OMEGA0[1]], [OMEGA0[2]]]
-    stepper = getattr(svIntegrators, integrator)(craft)
-    craft.setIntegrator(stepper)
+    from Basilisk.utilities import macros, RigidBodyKinematics
+    sim, craft = basilisk_body(MOMENTS, OMEGA0, DT, integrator)
     sim.AddModelToTask('step', craft)
     recorder = craft.scStateOutMsg.recorder(macros.sec2nano(10 * DT))
     sim.AddModelToTask('step', recorder)

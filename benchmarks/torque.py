@@ -32,6 +32,7 @@ import time
 
 from common import fmt
 import numpy as np
+from peers import basilisk_body, mujoco_body
 from rigid_body_dynamics.physics import make_integrator, quaternions, simulate
 from rigid_body_dynamics.physics.control import QuaternionPD
 from rigid_body_dynamics.physics.reference import zoh_reference
@@ -146,18 +147,8 @@ def run_simulate(case, dt=1e-2):
 
 def run_mujoco(case, dt, integrator='RK4'):
     """Run MuJoCo: free joint, zero gravity; body torque in qfrc_applied[3:6]."""
-    import mujoco
     moments, omega0, command = CASES[case]
-    xml = f"""
-    <mujoco>
-      <option gravity="0 0 0" timestep="{dt}" integrator="{integrator}"/>
-      <worldbody><body><freejoint/>
-        <inertial pos="0 0 0" mass="1" diaginertia="{moments[0]} {moments[1]} {moments[2]}"/>
-      </body></worldbody>
-    </mujoco>"""
-    model = mujoco.MjModel.from_xml_string(xml)
-    data = mujoco.MjData(model)
-    data.qvel[3:6] = omega0
+    mujoco, model, data = mujoco_body(moments, omega0, dt, integrator)
     per_hold = int(round(HOLD / dt))
 
     def state():
@@ -179,19 +170,11 @@ def run_mujoco(case, dt, integrator='RK4'):
 
 def run_basilisk(case, dt, integrator='svIntegratorRKF78'):
     """Basilisk hub with an ExtForceTorque effector; the torque set before each hold."""
-    from Basilisk.simulation import extForceTorque, spacecraft, svIntegrators
-    from Basilisk.utilities import macros, RigidBodyKinematics, SimulationBaseClass
+    from Basilisk.simulation import extForceTorque
+    from Basilisk.utilities import macros, RigidBodyKinematics
     from scipy.spatial.transform import Rotation
     moments, omega0, command = CASES[case]
-    sim = SimulationBaseClass.SimBaseClass()
-    process = sim.CreateNewProcess('dynamics')
-    process.addTask(sim.CreateNewTask('step', macros.sec2nano(dt)))
-    craft = spacecraft.Spacecraft()
-    craft.hub.mHub = 1.0
-    craft.hub.IHubPntBc_B = [[moments[0], 0, 0], [0, moments[1], 0], [0, 0, moments[2]]]
-    craft.hub.sigma_BNInit = [[0.0], [0.0], [0.0]]
-    craft.hub.omega_BN_BInit = [[c] for c in omega0]
-    craft.setIntegrator(getattr(svIntegrators, integrator)(craft))
+    sim, craft = basilisk_body(moments, omega0, dt, integrator)
     effector = extForceTorque.ExtForceTorque()
     craft.addDynamicEffector(effector)
     # the hub first (higher priority), then the effector: the torque set
