@@ -28,11 +28,13 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
-from . import conversions as conv
+from . import conversions as conv, diagnostics
 from .parameters import as_float, as_vector, check_change, ConfigurationError, descriptor
 from .runner import run
 from .throttle import ThrottledWarnings
-from ..physics import equations, estimators, Inertia, theory
+from .. import samples
+from ..physics import Inertia
+from ..physics.analysis import analyse, Tolerances, Trajectory
 
 NODE_NAME = 'attitude_analyzer'
 #: Samples needed before any rate is estimated.
@@ -44,15 +46,19 @@ LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                          reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
+#: Stamps (ns) before and after any real one: the baseline floor's "no limit" and "not yet".
+_ALWAYS, _NEVER = -2 ** 63, 2 ** 63 - 1
+
 OK, WARN, ERROR, STALE = (DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR,
                           DiagnosticStatus.STALE)
 
 
 class SampleBuffer:
     """
-    Attitude samples sorted by stamp (s): q (x, y, z, w), omega (rad/s, body), torque (N m, body).
+    Attitude samples sorted by stamp (integer ns): q (x, y, z, w), omega (rad/s, body).
 
-    ``add`` returns why the history restarted ('reset', 'gap') or None.
+    Applied-torque samples (N m, body) are kept beside them. ``add`` returns
+    why the history restarted ('reset', 'gap') or None.
     """
 
     def __init__(self):
@@ -64,7 +70,7 @@ class SampleBuffer:
         self.torque_t, self.torque = [], []
 
     def add(self, t, q, w, reset_jump, max_gap):
-        """Insert one state sample in stamp order; duplicates are dropped."""
+        """Insert one state sample (stamp t, ns) in stamp order; duplicates are dropped."""
         reason = None
         if self.t and t < self.t[-1] - reset_jump:
             reason = 'reset'
@@ -81,26 +87,31 @@ class SampleBuffer:
         return reason
 
     def add_torque(self, t, torque):
-        """Insert one applied-torque sample in stamp order."""
+        """Insert one applied-torque sample (stamp t, ns) in stamp order."""
         i = bisect.bisect_left(self.torque_t, t)
         if i < len(self.torque_t) and self.torque_t[i] == t:
             return
         self.torque_t.insert(i, t)
         self.torque.insert(i, torque)
 
+    def first_from(self, t):
+        """The earliest state sample (t, q, w) with stamp >= t (ns), or None."""
+        i = bisect.bisect_left(self.t, t)
+        return (self.t[i], self.q[i], self.w[i]) if i < len(self.t) else None
+
     def trim(self, keep_from):
-        """Drop samples older than ``keep_from`` (s)."""
+        """Drop samples older than ``keep_from`` (ns)."""
         i = bisect.bisect_left(self.t, keep_from)
         del self.t[:i], self.q[:i], self.w[:i]
         j = bisect.bisect_left(self.torque_t, keep_from)
         del self.torque_t[:j], self.torque[:j]
 
     def arrays(self):
-        """(t, q, omega, torque at the state stamps) as arrays; torque 0 where none is known."""
-        t = np.array(self.t)
+        """(t ns int64, q, omega, torque at the state stamps); torque 0 where none is known."""
+        t = np.array(self.t, dtype=np.int64)
         tau = np.zeros((t.size, 3))
         if self.torque_t:
-            idx = np.searchsorted(np.array(self.torque_t), t, side='right') - 1
+            idx = np.searchsorted(np.array(self.torque_t, dtype=np.int64), t, side='right') - 1
             known = idx >= 0
             tau[known] = np.array(self.torque)[idx[known]]
         return t, np.array(self.q), np.array(self.w), tau
@@ -131,6 +142,10 @@ class AttitudeAnalyzer(Node):
             'conservation is WARN (100x: ERROR). Sampled torque costs an O(dt) quadrature '
             'error at each torque change, so this is looser than the free-motion tolerances.',
             low=0.0, high=1.0, **num))
+        self.declare_parameter('rate_tolerance', 1e-6, descriptor(
+            'Relative difference between a measured rate or period of the free motion and '
+            'theory above which precession is WARN; 100x that is ERROR.',
+            low=0.0, high=1.0, **num))
         self.declare_parameter('stale_timeout', 1.0, descriptor(
             'Input is STALE when no odom arrived for this long (s, steady clock).',
             low=0.0, high=1e6, **num))
@@ -147,8 +162,11 @@ class AttitudeAnalyzer(Node):
         self._inertia_source = 'parameter' if self._settings['inertia'] else None
         self._inertia = self._settings['inertia']
         self._buffer = SampleBuffer()
-        self._baseline = None
-        self._restarts = {'reset': 0, 'gap': 0, 'non_finite': 0}
+        self._baseline = None                  # (t ns, q, omega) drift is measured from
+        self._baseline_floor = _ALWAYS         # ns: the baseline is a sample at/after this
+        self._last_torque = _ALWAYS            # ns: stamp of the newest non-zero torque
+        self._body_frame = None                # frame id of the inertia, when known
+        self._restarts = {'reset': 0, 'gap': 0, 'non_finite': 0, 'wrong_frame': 0}
         self._received = 0
         self._last_arrival = None
         self._rate_window = []
@@ -183,7 +201,7 @@ class AttitudeAnalyzer(Node):
         except (TypeError, ValueError) as err:
             raise ConfigurationError(f'inertia: {err}') from None
         for name, low, high in (('window', 0.1, 1e9), ('energy_tolerance', 0.0, 1.0),
-                                ('balance_tolerance', 0.0, 1.0),
+                                ('balance_tolerance', 0.0, 1.0), ('rate_tolerance', 0.0, 1.0),
                                 ('momentum_tolerance', 0.0, 1.0), ('stale_timeout', 0.0, 1e6),
                                 ('reset_jump', 0.0, 1e9), ('max_gap', 0.0, 1e9),
                                 ('diagnostic_period', 0.01, 3600.0)):
@@ -207,47 +225,77 @@ class AttitudeAnalyzer(Node):
     def _on_inertia(self, msg):
         if self._inertia_source == 'parameter':
             return
-        i = msg.inertia
+        tensor, frame = samples.inertia_tensor(msg)
         try:
-            body = Inertia.from_tensor([i.ixx, i.iyy, i.izz, i.ixy, i.ixz, i.iyz])
+            body = Inertia.from_tensor(tensor)
         except ValueError as err:
             self.get_logger().error(f'inertia topic refused: {err}')
             return
+        self._body_frame = frame or None
         if self._inertia is None or not np.allclose(body.tensor, self._inertia.tensor):
             self._inertia, self._inertia_source = body, 'topic'
             self._restart('inertia received')
-            self.get_logger().info(f'inertia from topic: {body.moments.tolist()} kg m^2')
+            self.get_logger().info(f'inertia from topic: {body.moments.tolist()} kg m^2 '
+                                   f'in frame {frame!r}')
 
     def _on_odom(self, msg):
         self._received += 1
         self._last_arrival = self._steady.now().nanoseconds
-        q = conv.quaternion_array(msg.pose.pose.orientation)
-        w = conv.vector_array(msg.twist.twist.angular)
+        try:
+            t, q, w = samples.odometry_sample(msg, self._body_frame)
+        except samples.FrameError as err:
+            self._restarts['wrong_frame'] += 1
+            self._warnings.warn('frame', f'odom sample dropped: {err}')
+            return
+        q, w = np.array(q), np.array(w)
         norm = float(np.linalg.norm(q))
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(w))) or norm < 0.5:
             self._restarts['non_finite'] += 1
             self._warnings.warn('non-finite', 'odom sample with a non-finite or zero quaternion '
                                 'or rate dropped')
             return
-        t = conv.time_ns(msg.header.stamp) * 1e-9
         s = self._settings
-        reason = self._buffer.add(t, q / norm, w, s['reset_jump'], s['max_gap'])
+        q = q / norm
+        reason = self._buffer.add(t, q, w, int(s['reset_jump'] * 1e9), int(s['max_gap'] * 1e9))
         if reason:
             self._restarts[reason] += 1
             self._restart(f'{"time went backwards" if reason == "reset" else "gap in stamps"} '
-                          f'at t = {t:.6g} s')
+                          f'at t = {t * 1e-9:.6f} s')
+        # the baseline is the earliest sample (by stamp) of the torque-free segment
+        if t >= self._baseline_floor and (self._baseline is None or t < self._baseline[0]):
+            self._baseline = (t, q, w)
 
     def _on_torque(self, msg):
-        vec = conv.vector_array(msg.wrench.torque)
-        if np.all(np.isfinite(vec)):
-            self._buffer.add_torque(conv.time_ns(msg.header.stamp) * 1e-9, vec)
+        try:
+            t, vec = samples.torque_sample(msg, self._body_frame)
+        except samples.FrameError as err:
+            self._warnings.warn('torque frame', f'applied torque dropped: {err}')
+            return
+        if not all(math.isfinite(c) for c in vec):
+            return
+        self._buffer.add_torque(t, vec)
+        # the torque-free segment (and so the baseline) starts at the first zero applied
+        # torque after the last non-zero one: the state stamped there is past every torque
+        if any(vec):
+            if t > self._last_torque:
+                self._last_torque = t
+                self._baseline_floor = _NEVER
+                self._baseline = None
+        elif self._baseline_floor == _NEVER and t > self._last_torque:
+            self._baseline_floor = t
+            self._baseline = self._buffer.first_from(t)
 
-    def _restart(self, why):
+    def _restart(self, why, floor=_ALWAYS):
         self._baseline = None
+        self._baseline_floor = floor
+        self._last_torque = _ALWAYS
         self.get_logger().info(f'estimates restart: {why}')
 
     def _on_reset_baseline(self, _request, response):
-        self._baseline = None
+        newest = self._buffer.t[-1] + 1 if self._buffer.t else _ALWAYS
+        floor, last = max(newest, self._baseline_floor), self._last_torque
+        self._restart('baseline reset on request', floor=floor)
+        self._last_torque = last
         response.success = True
         response.message = 'drift is measured from the next sample on'
         return response
@@ -260,32 +308,40 @@ class AttitudeAnalyzer(Node):
         statuses = [self._input_status(name, hw)]
         buf = self._buffer
         if buf.t:
-            buf.trim(buf.t[-1] - s['window'])
+            buf.trim(buf.t[-1] - int(s['window'] * 1e9))
+        checks = ('conservation', 'precession', 'stability')
         if self._inertia is None:
             text = 'no inertia yet: set the inertia parameter or publish the inertia topic'
-            for check in ('conservation', 'precession', 'stability'):
-                statuses.append(conv.status(f'{name}: {check}', WARN, text, [], hw))
-        elif len(buf.t) < MIN_SAMPLES:
-            text = f'not enough data yet ({len(buf.t)} of {MIN_SAMPLES} samples)'
-            for check in ('conservation', 'precession', 'stability'):
-                statuses.append(conv.status(f'{name}: {check}', OK, text, [], hw))
+            statuses += [conv.status(f'{name}: {c}', WARN, text, [], hw) for c in checks]
         else:
             t, q, w, tau = buf.arrays()
-            moments, frame = self._principal(q, w)
-            self._publish('kinetic_energy', float(equations.kinetic_energy(moments, frame[1][-1])))
-            self._publish('angular_momentum_norm',
-                          float(np.linalg.norm(moments * frame[1][-1])))
-            statuses.append(self._conservation(name, hw, t, frame, tau, moments))
-            statuses.append(self._precession(name, hw, t, frame, moments))
-            statuses.append(self._stability(name, hw, t, frame[1], moments))
+            origin = int(t[0]) if t.size else 0
+            trajectory = Trajectory.from_samples(t, q, w, self._inertia, tau, origin_ns=origin)
+            baseline = None
+            if self._baseline is not None:
+                b_t, b_q, b_w = self._baseline
+                baseline = (b_t - origin, b_q, b_w)
+            found = analyse(trajectory, baseline, self._tolerances())
+            if found.kinetic_energy is not None:
+                self._publish('kinetic_energy', found.kinetic_energy)
+                self._publish('angular_momentum_norm', found.angular_momentum_norm)
+            pre = found.precession
+            for topic, qty in (('precession/body_rate', pre.body_rate),
+                               ('precession/lab_rate', pre.lab_rate)):
+                if qty is not None and qty.measured is not None:
+                    self._publish(topic, qty.measured)
+            statuses += [diagnostics.conservation(found.conservation, name, hw, origin),
+                         diagnostics.precession(found.precession, name, hw),
+                         diagnostics.stability(found.stability, name, hw)]
         array = DiagnosticArray(status=statuses)
         array.header.stamp = self.get_clock().now().to_msg()
         self._pub_diag.publish(array)
 
-    def _principal(self, q, w):
-        """Return the moments and the samples in the principal frame: (q, omega)."""
-        body = self._inertia
-        return body.moments, (body.attitude_to_principal(q), body.to_principal(w))
+    def _tolerances(self):
+        s = self._settings
+        return Tolerances(energy=s['energy_tolerance'], momentum=s['momentum_tolerance'],
+                          balance=s['balance_tolerance'], rate=s['rate_tolerance'],
+                          min_samples=MIN_SAMPLES)
 
     def _publish(self, topic, value):
         self._pub[topic].publish(Float64(data=value))
@@ -301,7 +357,9 @@ class AttitudeAnalyzer(Node):
                   ('restarts after a time reset', self._restarts['reset']),
                   ('restarts after a gap', self._restarts['gap']),
                   ('dropped non-finite samples', self._restarts['non_finite']),
-                  ('inertia source', self._inertia_source or 'none')]
+                  ('dropped samples in another frame', self._restarts['wrong_frame']),
+                  ('inertia source', self._inertia_source or 'none'),
+                  ('body frame', self._body_frame or 'any')]
         if self._last_arrival is None:
             return conv.status(f'{name}: input', STALE, 'no odom received yet', values, hw)
         age = (now - self._last_arrival) * 1e-9
@@ -309,163 +367,6 @@ class AttitudeAnalyzer(Node):
         if age > max(self._settings['stale_timeout'], period):
             return conv.status(f'{name}: input', STALE, f'no odom for {age:.1f} s', values, hw)
         return conv.status(f'{name}: input', OK, f'receiving odom at {rate:.3g} Hz', values, hw)
-
-    def _conservation(self, name, hw, t, frame, tau, moments):
-        """
-        Free motion: drift of T, |L| and L_w direction since the baseline.
-
-        While the window holds torque: the work-energy and impulse-momentum
-        residuals over the window instead (sampled torque, trapezoid), against
-        ``balance_tolerance``. Once the torque has left the window the
-        baseline restarts from the newest sample.
-        """
-        q, w = frame
-        s = self._settings
-        tau_p = self._inertia.to_principal(tau)
-        under_torque = bool(np.any(tau_p != 0.0))
-        if under_torque:
-            self._baseline = None
-        elif self._baseline is None:
-            self._baseline = (t[-1], equations.kinetic_energy(moments, w[-1]),
-                              equations.angular_momentum_world(moments, q[-1], w[-1]))
-        if under_torque:
-            bal = estimators.balance(t, q, w, tau_p, moments)
-            e_err, l_err, d_err = bal.energy, bal.momentum, 0.0
-            tol_e = tol_l = s['balance_tolerance']
-            values = [('mode', 'balance laws (torque applied in the window)'),
-                      ('work-energy residual (rel.)', e_err),
-                      ('impulse-momentum residual (rel.)', l_err),
-                      ('work over the window (J)', bal.work)]
-        else:
-            t0, e0, l0 = self._baseline
-            e1 = equations.kinetic_energy(moments, w[-1])
-            l1 = equations.angular_momentum_world(moments, q[-1], w[-1])
-            e_err = abs(e1 - e0) / e0 if e0 else 0.0
-            g0 = float(np.linalg.norm(l0))
-            l_err = abs(float(np.linalg.norm(l1)) - g0) / g0 if g0 else 0.0
-            d_err = float(estimators.vector_angle(l1, l0))
-            tol_e, tol_l = s['energy_tolerance'], s['momentum_tolerance']
-            values = [('mode', 'free motion'), ('baseline stamp (s)', float(t0)),
-                      ('energy drift since baseline (rel.)', e_err),
-                      ('|L| drift since baseline (rel.)', l_err),
-                      ('L direction drift since baseline (rad)', d_err)]
-        worst_e = e_err / tol_e if tol_e else 0.0
-        worst_l = max(l_err, d_err) / tol_l if tol_l else 0.0
-        worst = max(worst_e, worst_l)
-        level = OK if worst <= 1.0 else (WARN if worst <= 100.0 else ERROR)
-        if level == OK:
-            message = 'balance laws hold under torque' if under_torque else 'conserved'
-        else:
-            what = 'energy' if worst_e >= worst_l else 'angular momentum'
-            message = f'{what} off by {worst:.3g} x tolerance'
-        values += [('energy tolerance', tol_e), ('momentum tolerance', tol_l)]
-        return conv.status(f'{name}: conservation', level, message, values, hw)
-
-    def _precession(self, name, hw, t, frame, moments):
-        q, w = frame
-        body = self._inertia
-        axis = body.symmetry_axis
-        values = []
-        if axis is None and body.kind == 'spherical':
-            return conv.status(f'{name}: precession', OK, 'a spherical body does not precess',
-                               values, hw)
-        if axis is None:
-            return self._asymmetric_precession(name, hw, t, q, w, moments)
-        i_perp = float(np.mean([moments[(axis + 1) % 3], moments[(axis + 2) % 3]]))
-        w_axis = float(w[-1, axis])
-        w_perp = float(math.hypot(w[-1, (axis + 1) % 3], w[-1, (axis + 2) % 3]))
-        g = float(np.linalg.norm(moments * w[-1]))
-        body_theory = theory.body_precession_rate(i_perp, moments[axis], w_axis)
-        lab_theory = theory.lab_precession_rate(i_perp, g)
-        cones = theory.cone_angles(i_perp, moments[axis], w_perp, w_axis)
-        body_rate = estimators.body_precession_rate(t, w, axis).rate
-        lab_rate = estimators.lab_precession_rate(t, q, w, moments, axis).rate
-        self._publish('precession/body_rate', body_rate)
-        self._publish('precession/lab_rate', lab_rate)
-        rel_body = abs(body_rate - body_theory) / abs(body_theory) if body_theory else math.nan
-        rel_lab = abs(lab_rate - lab_theory) / abs(lab_theory)
-        values += [('body rate, measured (rad/s)', body_rate),
-                   ('body rate, theory (rad/s)', body_theory),
-                   ('body rate error (rel.)', rel_body),
-                   ('lab rate, measured (rad/s)', lab_rate),
-                   ('lab rate, theory (rad/s)', lab_theory), ('lab rate error (rel.)', rel_lab),
-                   ('body cone half-angle (rad)', cones.body),
-                   ('lab cone half-angle (rad)', cones.lab),
-                   ('nutation angle (rad)', cones.nutation)]
-        return conv.status(f'{name}: precession', OK,
-                           f'body {body_rate:.6g} rad/s (theory {body_theory:.6g}), '
-                           f'lab {lab_rate:.6g} rad/s (theory {lab_theory:.6g})', values, hw)
-
-    def _asymmetric_precession(self, name, hw, t, q, w, moments):
-        """
-        Period of omega(t) and mean precession about L of the axis the polhode circles.
-
-        Both are measured only once the window spans a full period of omega
-        (a shorter window would alias the nutation into the rates).
-        """
-        period = theory.omega_period(moments, w[-1])
-        polhode = theory.polhode(moments, w[-1])
-        values = [('polhode family', polhode.family), ('omega period, theory (s)', period)]
-        if not math.isfinite(period) or polhode.circled_axis is None:
-            return conv.status(f'{name}: precession', OK,
-                               f'no periodic precession ({polhode.family})', values, hw)
-        axis = polhode.circled_axis
-        mean_rate = theory.mean_precession_rate(moments, w[-1], axis)
-        values.append((f'mean precession of axis {axis + 1} about L, theory (rad/s)', mean_rate))
-        if t[-1] - t[0] < period:
-            return conv.status(f'{name}: precession', OK,
-                               f'window ({t[-1] - t[0]:.3g} s) shorter than a period of omega '
-                               f'({period:.6g} s): no measurement yet', values, hw)
-        # omega about the middle axis is a2 sn(u) in both families: its zero crossings
-        # are exactly half a period apart (no mean to remove)
-        mid = int(np.argsort(moments)[1])
-        try:
-            measured = estimators.crossing_period(t, w[:, mid], 0)
-        except ValueError:
-            measured = math.nan
-        lab = estimators.lab_precession_rate(t, q, w, moments, axis).rate
-        values += [('omega period, measured (s)', measured),
-                   ('omega period error (rel.)', abs(measured - period) / period),
-                   (f'mean precession of axis {axis + 1} about L, measured (rad/s)', lab)]
-        return conv.status(f'{name}: precession', OK,
-                           f'omega period {measured:.6g} s (theory {period:.6g}), axis '
-                           f'{axis + 1} precesses about L at {lab:.6g} rad/s (theory '
-                           f'{mean_rate:.6g})', values, hw)
-
-    def _stability(self, name, hw, t, w, moments):
-        """
-        Classify the spin about the principal axis the motion stays nearest over the window.
-
-        (During a tennis-racket flip omega passes other axes for a moment; the
-        window average does not.) The spin about that axis is |L| / I_axis.
-        """
-        omega = w[-1]
-        axis = int(np.argmax(np.mean(np.abs(w), axis=0)))
-        spin = math.copysign(float(np.linalg.norm(moments * omega)) / moments[axis],
-                             omega[axis] if omega[axis] else 1.0)
-        st = theory.axis_stability(moments, axis, spin)
-        pol = theory.polhode(moments, omega)
-        values = [('nearest principal axis', st.axis + 1), ('class', st.kind),
-                  ('polhode family', pol.family),
-                  ('separatrix distance (S/G^2)', pol.separatrix_distance)]
-        if st.kind == 'unstable':
-            flip = theory.flip_interval(moments, omega)
-            values += [('growth rate, theory (1/s)', st.rate), ('flip interval, theory (s)', flip)]
-            message = f'spin about axis {st.axis + 1} is unstable: growth rate {st.rate:.6g} 1/s'
-            for label, estimate in (('growth rate, measured (1/s)', lambda: (
-                    estimators.separatrix_growth_rate(t, w, moments))),
-                    ('flip interval, measured (s)', lambda: estimators.flip_interval(
-                        t, w, st.axis))):
-                try:
-                    values.append((label, estimate()))
-                except ValueError as err:
-                    values.append((label, f'not available: {err}'))
-            level = WARN
-        else:
-            values.append(('wobble frequency (rad/s)', st.rate))
-            message = f'spin about axis {st.axis + 1} is {st.kind}'
-            level = OK
-        return conv.status(f'{name}: stability', level, message, values, hw)
 
 
 def main(args=None, early=None):
