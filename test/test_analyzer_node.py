@@ -83,6 +83,9 @@ def test_symmetric_top_precession_and_conservation(launch, probe):
     assert float(values['energy drift since baseline (rel.)']) < 1e-12
     level, message, values = probe.newest_status('attitude_analyzer: stability')
     assert values['class'] == 'stable' and values['nearest principal axis'] == '3'
+    # one frequency, one number: the top's wobble is its body precession Omega
+    assert float(values['wobble frequency, theory (rad/s)']) == pytest.approx(1.0, rel=1e-12)
+    assert float(values['wobble frequency error (rel.)']) < 1e-4
     level, message, values = probe.newest_status('attitude_analyzer: input')
     assert level == DiagnosticStatus.OK and float(values['rate (Hz)']) > 100.0
     assert values['inertia source'] == 'topic'
@@ -276,3 +279,77 @@ def test_bad_parameters_are_refused(launch):
     proc = launch(ANALYZER, '-p', 'inertia:=[1.0, 1.0, 3.0]', name='bad')
     assert proc.wait(20.0) == 1
     assert 'triangle inequality' in proc.output()
+
+
+def test_drift_is_measured_from_the_first_stamp_whatever_the_arrival(launch, probe):
+    """
+    A burst of 10 s of stamps, sent within a fraction of the first analysis period.
+
+    The baseline is the first sample by stamp (t = 0), not whatever sample was newest at the
+    first analysis: energy drift (1 + 1e-4 t)^2 - 1 = 2.0e-3 at t = 10 s.
+    """
+    analyzer = launch(ANALYZER, '-p', 'inertia:=[1.0, 1.0, 1.5]', '-p', 'window:=20.0',
+                      name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    pub = _odom_publisher(probe, body)
+    _publish_states(probe, pub, np.arange(0.01, 10.005, 0.01), body,
+                    scale=lambda t: 1 + 1e-4 * t)
+    level, message, values = wait_status(
+        probe, 'conservation', lambda v: float(v.get('energy drift since baseline (rel.)', 0))
+        > 1.9e-3, 20.0, 'the drift of the whole burst')
+    assert float(values['baseline stamp (s)']) == 0.0
+    assert float(values['energy drift since baseline (rel.)']) == pytest.approx(
+        (1 + 1e-3) ** 2 - 1, rel=2e-3)
+    assert level == DiagnosticStatus.ERROR
+    stop_cleanly(analyzer)
+
+
+def test_twist_frames_are_honoured(launch, probe):
+    """
+    A twist in the world frame (child_frame_id = header.frame_id) is rotated into the body.
+
+    Twists in a third frame are dropped and counted, never analysed as body rates.
+    """
+    from geometry_msgs.msg import InertiaStamped
+    from ros_harness import LATCHED
+    from rigid_body_dynamics.nodes.conversions import vector_msg as vec
+    from rigid_body_dynamics.physics import quaternions
+    analyzer = launch(ANALYZER, name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    inertia = probe.node.create_publisher(InertiaStamped, 'inertia', LATCHED)
+    latched = InertiaStamped()
+    latched.header.frame_id = 'base_link'
+    latched.inertia.ixx, latched.inertia.iyy, latched.inertia.izz = 1.0, 1.0, 1.5
+    inertia.publish(latched)
+    body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    pub = probe.publisher(Odometry, 'odom')
+
+    def world_twist(t, q, w):
+        msg = odom_msg(t, q, w)
+        msg.child_frame_id = 'odom'
+        msg.twist.twist.angular = vec(quaternions.rotate(q, w))
+        return msg
+    q0, w0 = body.state_at(np.array([0.0]))
+    probe.handshake(pub, world_twist(0.0, q0[0], w0[0]), lambda: analyzer_heard(probe))
+    times = np.arange(0.01, 6.0, 0.01)
+    q, w = body.state_at(times)
+    for k, t in enumerate(times):
+        pub.publish(world_twist(t, q[k], w[k]))
+        if k % 50 == 0:
+            probe.spin_for(0.005)
+    level, message, values = wait_status(
+        probe, 'precession', lambda v: 'body rate error (rel.)' in v, 20.0, 'an estimate')
+    assert float(values['body rate, theory (rad/s)']) == pytest.approx(1.0, rel=1e-12)
+    assert float(values['body rate error (rel.)']) < 1e-9
+    wrong = 30
+    for k in range(wrong):
+        msg = odom_msg(6.0 + 0.01 * k, q[0], w[0])
+        msg.child_frame_id = 'imu_link'
+        pub.publish(msg)
+    level, message, values = wait_status(
+        probe, 'input', lambda v: int(v.get('dropped samples in another frame', 0)) >= wrong,
+        20.0, 'the samples in imu_link to be dropped')
+    assert int(values['dropped samples in another frame']) == wrong
+    assert values['body frame'] == 'base_link'
+    stop_cleanly(analyzer)

@@ -1,0 +1,153 @@
+"""The one analysis (physics/analysis.py): findings against closed forms, statuses, defects."""
+
+import math
+
+import numpy as np
+import pytest
+from rigid_body_dynamics.physics import FreeRigidBody, presets, simulate, theory
+from rigid_body_dynamics.physics.analysis import (analyse, ERROR, OK, Trajectory, UNAVAILABLE,
+                                                  WARN)
+
+#: 2026-12-01 in ns since 1970: stamps as a live system has them
+EPOCH_2026 = 1_764_547_200_000_000_000
+
+
+def top_trajectory(duration=10.0, rate=1000.0, origin_ns=0, omega_scale=None):
+    """Exact symmetric-top samples at ``rate`` Hz, stamped in integer ns from ``origin_ns``."""
+    body = FreeRigidBody((1.0, 1.0, 1.5), (0.3, 0.0, 2.0))
+    k = np.arange(int(duration * rate) + 1)
+    t_ns = origin_ns + (k * round(1e9 / rate)).astype(np.int64)
+    q, w = body.state_at((t_ns - origin_ns) * 1e-9)
+    if omega_scale is not None:
+        w = w * omega_scale((t_ns - origin_ns) * 1e-9)[:, None]
+    return Trajectory.from_samples(t_ns, q, w, (1.0, 1.0, 1.5))
+
+
+def test_symmetric_top_rates_and_statuses():
+    found = analyse(top_trajectory())
+    p = found.precession
+    assert p.kind == 'axisymmetric' and p.status == OK
+    assert p.body_rate.theory == pytest.approx(1.0, rel=1e-15)
+    assert p.body_rate.relative_error < 1e-12 and p.lab_rate.relative_error < 1e-12
+    assert found.conservation.status == OK and found.conservation.energy_drift < 1e-14
+    assert found.stability.kind == 'stable' and found.stability.axis == 2
+
+
+def test_stamps_since_1970_lose_nothing():
+    """Defect 5: integer ns from a 2026 origin give the same rates as from 0 (float s: ~1e-10)."""
+    near = analyse(top_trajectory(origin_ns=0)).precession
+    far = analyse(top_trajectory(origin_ns=EPOCH_2026)).precession
+    assert far.body_rate.relative_error < 1e-12
+    assert far.body_rate.measured == pytest.approx(near.body_rate.measured, rel=1e-13)
+    # what float seconds since 1970 would have done to the same stamps
+    t_float = (EPOCH_2026 + np.arange(10001) * 1_000_000) * 1e-9
+    assert np.max(np.abs(np.diff(t_float) - 1e-3)) > 1e-8
+
+
+def test_top_wobble_and_precession_are_one_frequency():
+    """Defect 3: the stable wobble of a top is its body precession Omega, not |L| / I3."""
+    found = analyse(top_trajectory())
+    wobble, omega = found.stability.wobble_frequency, found.precession.body_rate
+    assert wobble.theory == pytest.approx(abs(omega.theory), rel=1e-14)
+    assert wobble.measured == pytest.approx(abs(omega.measured), rel=1e-14)
+    spin = math.hypot(1.0 * 0.3, 1.5 * 2.0) / 1.5        # what |L| / I3 gives instead
+    assert abs(theory.axis_stability((1.0, 1.0, 1.5), 2, spin).rate / wobble.theory - 1) > 4e-3
+
+
+@pytest.mark.parametrize('periods', [2.3, 2.5, 3.9])
+def test_asymmetric_mean_precession_over_whole_periods(periods):
+    """Defect 4: a window that is not a whole number of periods still measures the mean rate."""
+    body = presets.get('stable_major')
+    period = theory.omega_period(body.moments, body.omega0)
+    run = simulate(body.moments, body.omega0, body.q0, duration=periods * period, dt=1e-2)
+    p = analyse(Trajectory.from_simulation(run)).precession
+    assert p.kind == 'asymmetric' and p.status == OK, p.message
+    assert p.mean_precession.relative_error < 1e-9
+    assert p.omega_period.relative_error < 5e-8     # zero crossings interpolated linearly
+
+
+def test_a_wrong_precession_is_flagged_not_labelled_ok():
+    """A simulator whose body rate turns 1e-4 too fast: precession WARN, with the error."""
+    traj = top_trajectory()
+    # rotate omega about the symmetry axis a little faster than physics: Omega * (1 + 1e-4)
+    phase = 1e-4 * 1.0 * traj.t
+    c, s = np.cos(phase), np.sin(phase)
+    w = traj.omega.copy()
+    w[:, 0], w[:, 1] = c * traj.omega[:, 0] - s * traj.omega[:, 1], \
+        s * traj.omega[:, 0] + c * traj.omega[:, 1]
+    bad = Trajectory.from_samples(traj.t_ns, traj.q, w, traj.inertia)
+    p = analyse(bad).precession
+    assert p.status == ERROR and p.body_rate.status == ERROR
+    assert p.body_rate.relative_error == pytest.approx(1e-4, rel=1e-3)
+
+
+def test_energy_drift_from_the_first_sample_by_stamp():
+    """Defect 1 at the analysis level: drift from the baseline, whatever order samples came in."""
+    traj = top_trajectory(omega_scale=lambda t: 1.0 + 1e-4 * t)
+    shuffled = np.random.default_rng(3).permutation(len(traj))
+    again = Trajectory.from_samples(traj.t_ns[shuffled], traj.q[shuffled],
+                                    traj.omega[shuffled], traj.inertia)
+    for found in (analyse(traj), analyse(again)):
+        c = found.conservation
+        assert c.baseline_ns == 0
+        assert c.energy_drift == pytest.approx((1.0 + 1e-3) ** 2 - 1.0, rel=1e-9)
+        assert c.status == ERROR
+
+
+def test_an_explicit_baseline_outside_the_window():
+    traj = top_trajectory(omega_scale=lambda t: 1.0 + 1e-4 * t)
+    window = traj.between(start=5.0)
+    base = (int(traj.t_ns[0]), traj.q[0], traj.omega[0])
+    c = analyse(window, baseline=base).conservation
+    assert c.energy_drift == pytest.approx((1.0 + 1e-3) ** 2 - 1.0, rel=1e-9)
+    assert analyse(window).conservation.energy_drift < 1.1e-3     # from its own first sample
+
+
+def test_not_enough_data_and_torque_say_why():
+    found = analyse(top_trajectory(duration=0.01))
+    assert found.precession.status == UNAVAILABLE
+    assert 'not enough data yet (11 of 20 samples)' in found.precession.message
+    body = presets.get('tennis_racket')
+    run = simulate(body.moments, body.omega0, body.q0, duration=5.0, dt=1e-2,
+                   torque=(0.0, 0.0, 0.05))
+    found = analyse(Trajectory.from_simulation(run))
+    assert found.under_torque and found.conservation.mode == 'balance laws'
+    assert found.precession.status == UNAVAILABLE and 'torque' in found.precession.message
+    assert found.stability.flip_interval.measured is None
+    assert found.stability.status == WARN                       # still unstable
+
+
+def test_short_window_asymmetric_precession_is_unavailable_with_theory():
+    body = presets.get('tennis_racket')
+    run = simulate(body.moments, body.omega0, body.q0, duration=5.0, dt=1e-2)
+    p = analyse(Trajectory.from_simulation(run)).precession
+    assert p.status == UNAVAILABLE and 'shorter than a period' in p.message
+    assert p.omega_period.theory == pytest.approx(
+        theory.omega_period(body.moments, body.omega0), rel=1e-11)   # near the separatrix
+
+
+def test_json_form_has_the_documented_keys():
+    d = analyse(top_trajectory()).to_dict()
+    assert d['samples'] == 10001 and d['span_s'] == pytest.approx(10.0)
+    assert set(d['conservation']) >= {'status', 'energy_drift', 'momentum_drift',
+                                      'direction_drift'}
+    assert set(d['precession']) >= {'status', 'body_rate', 'body_rate_theory', 'lab_rate',
+                                    'lab_rate_theory'}
+    assert set(d['stability']) >= {'status', 'axis', 'class', 'growth_rate',
+                                   'growth_rate_theory', 'flip_interval',
+                                   'flip_interval_theory'}
+    assert d['stability']['axis'] == 3 and d['stability']['growth_rate'] is None
+
+
+def test_from_samples_drops_bad_samples_and_duplicates():
+    traj = top_trajectory(duration=0.1)
+    t = np.concatenate([traj.t_ns, traj.t_ns[:5]])
+    q = np.concatenate([traj.q, traj.q[:5]])
+    w = np.concatenate([traj.omega, traj.omega[:5]])
+    q[3] = np.nan
+    q[7] = 0.0
+    w[9, 1] = np.inf
+    again = Trajectory.from_samples(t, q, w, traj.inertia)
+    # rows 7 and 9 go; row 3's stamp comes back from its duplicate
+    assert len(again) == len(traj) - 2 and again.dropped == 3
+    assert np.all(np.diff(again.t_ns) > 0)
