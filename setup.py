@@ -31,6 +31,7 @@ setup(
             'poinsot_visualizer = rigid_body_dynamics.nodes.entry:poinsot',
             'attitude_fleet = rigid_body_dynamics.nodes.entry:fleet',
             'rigid_body_report = rigid_body_dynamics.report:main',
+            'rigid_body_analyze = rigid_body_dynamics.analyze:main',
         ],
     },
 )

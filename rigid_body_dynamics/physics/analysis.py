@@ -98,12 +98,12 @@ class Trajectory:
     @property
     def t(self):
         """Stamps (s) since ``origin_ns``, from the integer ns (exact to double precision)."""
-        return self.t_ns.astype(float) * 1e-9
+        return self.t_ns.astype(float) / 1e9
 
     @property
     def span(self):
         """Seconds between the first and the last sample (0 for fewer than two)."""
-        return float(self.t_ns[-1] - self.t_ns[0]) * 1e-9 if len(self) > 1 else 0.0
+        return float(self.t_ns[-1] - self.t_ns[0]) / 1e9 if len(self) > 1 else 0.0
 
     def between(self, start=None, end=None):
         """Keep the samples with start <= t - t_first <= end (s from the first stamp)."""
