@@ -1,20 +1,22 @@
 """
-rigid_body_report: figures and one HTML page about a run, offline or from a recording.
+rigid_body_report: figures and one HTML page about a run, offline or from a bag.
 
     rigid_body_report --preset tennis_racket --duration 60 --out report/
-    rigid_body_report --record run.npz --duration 20       # from the topics (nodes running)
-    rigid_body_report --recording run.npz --out report/
+    rigid_body_report --record run_bag --duration 20      # from the topics (nodes running)
+    rigid_body_report --bag run_bag --out report/         # any rosbag2 folder or .mcap file
 
 Figures (PNG, matplotlib Agg, no screen needed): omega components against time;
 the polhode on the inertia ellipsoid (3D, body frame); the herpolhode in the
 invariant plane; drift of T, |L| and the L direction on a log scale; the
 measured precession against theory (axisymmetric bodies) or the flips of an
-unstable spin against theory (tennis racket). index.html shows them with a
-table of measured against predicted numbers.
+unstable spin against theory (tennis racket). index.html shows them with the
+table of measured against predicted numbers from the one analysis
+(:func:`~rigid_body_dynamics.physics.analysis.analyse`).
 
-A recording is a .npz file with arrays ``t`` (N,) s, ``q`` (N, 4) x-y-z-w,
-``omega`` (N, 3) rad/s body frame, ``tensor`` (3, 3) kg m^2 body frame and
-optionally ``torque`` (N, 3) N m body frame.
+``--record`` writes a rosbag2 bag (MCAP storage, metadata version 9) of
+``odom``, ``applied_torque`` and the latched ``inertia`` (its transient-local
+QoS recorded, so ``ros2 bag play`` latches it again), which ``ros2 bag
+info/play``, Foxglove, PlotJuggler, ``rigid_body_analyze`` and ``--bag`` open.
 """
 
 import argparse
@@ -26,101 +28,79 @@ import time
 
 import numpy as np
 
-from .physics import (estimators, Inertia, INTEGRATORS, presets, quaternions, simulate,
-                      theory)
-
-
-class Run:
-    """The samples a report is made from (body frame = the inertia's frame)."""
-
-    def __init__(self, t, q, omega, inertia, torque=None, title=''):
-        self.t = np.asarray(t, dtype=float)
-        self.q = quaternions.normalize(np.asarray(q, dtype=float))
-        self.omega = np.asarray(omega, dtype=float)
-        self.torque = np.zeros_like(self.omega) if torque is None else np.asarray(torque, float)
-        self.inertia = inertia
-        self.title = title
-
-
-def load_recording(path):
-    """Read a recording (.npz, see the module docstring); ValueError saying what is wrong."""
-    try:
-        data = np.load(path)
-        t, q, w, tensor = data['t'], data['q'], data['omega'], data['tensor']
-        torque = data['torque'] if 'torque' in data.files else None
-    except (OSError, KeyError, ValueError, EOFError) as err:
-        raise ValueError(f'cannot read recording {path!r}: {err}') from None
-    n = t.shape[0] if t.ndim == 1 else -1
-    if n < 3 or q.shape != (n, 4) or w.shape != (n, 3) or tensor.shape != (3, 3):
-        raise ValueError(f'recording {path!r} does not hold t (N,), q (N, 4), omega (N, 3) and '
-                         f'tensor (3, 3) with N >= 3')
-    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(q)) and np.all(np.isfinite(w))):
-        raise ValueError(f'recording {path!r} holds non-finite samples')
-    if torque is None or torque.shape != w.shape:
-        torque = np.zeros_like(w)
-    t, q, w, torque = estimators.sort_samples(t, q, w, torque)
-    return Run(t, q, w, Inertia.from_tensor(tensor), torque, title=os.path.basename(path))
-
-
-def save_recording(path, run):
-    """Write ``run`` as a recording (.npz)."""
-    np.savez(path, t=run.t, q=run.q, omega=run.omega, tensor=run.inertia.tensor,
-             torque=run.torque)
+from .bags import BagError, BagWriter, INERTIA, ODOMETRY, read_trajectory, WRENCH
+from .physics import estimators, INTEGRATORS, presets, quaternions, simulate, theory
+from .physics.analysis import analyse, drift_series, Trajectory
 
 
 def offline_run(preset, integrator, duration, dt, progress=None):
-    """Simulate a preset; ``progress(fraction)`` is called as the run goes."""
+    """Simulate a preset; ``progress(fraction)`` is called as the run goes. Returns a Trajectory."""
     body = presets.get(preset)
     result = simulate(body.moments, body.omega0, body.q0, duration, dt, integrator=integrator,
                       progress=progress)
-    return Run(result.t, result.q, result.omega, result.inertia, result.torque,
-               title=f'{preset} ({integrator}, dt = {dt:g} s)')
+    return Trajectory.from_simulation(result, title=f'{preset} ({integrator}, dt = {dt:g} s)')
 
 
 def record(path, duration, timeout=60.0):
-    """Record odom, applied_torque and the latched inertia from the running nodes."""
+    """
+    Record odom, applied_torque and the latched inertia of the running nodes into a bag.
+
+    Messages are taken serialised and written as they came, with their
+    receive time and fully qualified topic names, as ``ros2 bag record``
+    does (only odom's header is decoded, to know when to stop); stops once
+    ``duration`` s of odom stamps and the inertia are in. Returns the bag's
+    Trajectory (read back with :func:`~rigid_body_dynamics.bags.read_trajectory`).
+    """
     import rclpy
     from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from rclpy.serialization import deserialize_message
     from geometry_msgs.msg import InertiaStamped, WrenchStamped
     from nav_msgs.msg import Odometry
-    from .nodes import conversions as conv
+    from .samples import stamp_ns
     ctx = Context()
     rclpy.init(context=ctx)
     node = rclpy.create_node('rigid_body_report', context=ctx)
     executor = SingleThreadedExecutor(context=ctx)
     executor.add_node(node)
-    odom, torque, inertia = [], [], []
+    stamps, inertia, out = [], [], {}
     deep = QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE)
-    node.create_subscription(Odometry, 'odom', odom.append, deep)
-    node.create_subscription(WrenchStamped, 'applied_torque', torque.append, deep)
-    node.create_subscription(InertiaStamped, 'inertia', inertia.append, QoSProfile(
-        depth=1, reliability=ReliabilityPolicy.RELIABLE,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL))
-    deadline = time.monotonic() + timeout + duration
+    latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
-    def span():
-        return (conv.time_ns(odom[-1].header.stamp) - conv.time_ns(odom[0].header.stamp)) * 1e-9
+    def keep(name):
+        def on_message(raw):
+            out['writer'].write(name, node.get_clock().now().nanoseconds, raw)
+            if name.endswith('odom'):
+                stamps.append(stamp_ns(deserialize_message(raw, Odometry).header.stamp))
+            elif name.endswith('inertia'):
+                inertia.append(True)
+        return on_message
     try:
-        while time.monotonic() < deadline and not (inertia and odom and span() >= duration):
-            executor.spin_once(timeout_sec=0.05)
+        topics = {}
+        for topic, msg_type, type_name, qos in (
+                ('odom', Odometry, ODOMETRY, deep),
+                ('applied_torque', WrenchStamped, WRENCH, deep),
+                ('inertia', InertiaStamped, INERTIA, latched)):
+            # bags name topics fully qualified, as ros2 bag record does
+            name = node.resolve_topic_name(topic)
+            topics[name] = (type_name, qos is latched)
+            node.create_subscription(msg_type, topic, keep(name), qos, raw=True)
+        with BagWriter(path, topics, 'mcap') as writer:
+            out['writer'] = writer
+            deadline = time.monotonic() + timeout + duration
+            while time.monotonic() < deadline and not (
+                    inertia and stamps and (max(stamps) - min(stamps)) * 1e-9 >= duration):
+                executor.spin_once(timeout_sec=0.05)
     finally:
         executor.shutdown()
         node.destroy_node()
         rclpy.shutdown(context=ctx)
-    if not inertia or len(odom) < 3:
-        raise ValueError('nothing recorded: is attitude_simulator running in this domain?')
-    i = inertia[-1].inertia
-    t = np.array([conv.time_ns(m.header.stamp) * 1e-9 for m in odom])
-    tq = {conv.time_ns(m.header.stamp): conv.vector_array(m.wrench.torque) for m in torque}
-    run = Run(t, [conv.quaternion_array(m.pose.pose.orientation) for m in odom],
-              [conv.vector_array(m.twist.twist.angular) for m in odom],
-              Inertia.from_tensor([i.ixx, i.iyy, i.izz, i.ixy, i.ixz, i.iyz]),
-              [tq.get(conv.time_ns(m.header.stamp), np.zeros(3)) for m in odom],
-              title=os.path.basename(path))
-    save_recording(path, run)
-    return run
+    if not inertia or len(stamps) < 3:
+        raise BagError(f'nothing usable recorded into {path}: is attitude_simulator running '
+                       'in this domain?')
+    return read_trajectory(path)[0]
 
 
 def _figure(title, xlabel, ylabel, projection=None):
@@ -192,63 +172,81 @@ def make_report(run, out_dir):
     ax.legend(loc='best')
     figures['herpolhode'] = (_save(fig, out_dir, 'herpolhode.png'), {'herpolhode': plane})
 
+    found = analyse(run)
     floor = np.finfo(float).eps
-    g = np.linalg.norm(l_world, axis=1)
-    drift = {'|T/T0 - 1|': np.abs(energy / energy[0] - 1.0),
-             '||L|/|L0| - 1|': np.abs(g / g[0] - 1.0),
-             'angle(L, L0) (rad)': estimators.vector_angle(l_world, l_world[0])}
+    drift = dict(zip(('|T/T0 - 1|', '||L|/|L0| - 1|', 'angle(L, L0) (rad)'),
+                     drift_series(moments, q, w, q[0], w[0])))
     fig, ax = _figure('Conservation: drift from the first sample (log scale; floor = eps)',
                       'time (s)', 'relative drift')
     for label, values in drift.items():
         ax.semilogy(t, np.maximum(values, floor), label=label)
     ax.legend(loc='best')
     figures['conservation'] = (_save(fig, out_dir, 'conservation.png'), drift)
-    rows += [('largest energy drift (rel.)', f'{drift["|T/T0 - 1|"].max():.2e}', '0'),
-             ('largest |L| drift (rel.)', f'{drift["||L|/|L0| - 1|"].max():.2e}', '0'),
-             ('largest L direction drift (rad)', f'{drift["angle(L, L0) (rad)"].max():.2e}',
-              '0')]
 
-    shape_axis = inertia.symmetry_axis
-    if shape_axis is not None:
-        ax_i = shape_axis
+    pre, stab = found.precession, found.stability
+    if pre.kind == 'axisymmetric':
+        ax_i = pre.symmetry_axis
         others = [j for j in range(3) if j != ax_i]
-        i_perp = float(np.mean(moments[others]))
-        rate = theory.body_precession_rate(i_perp, moments[ax_i], w[0, ax_i])
+        rate, measured = pre.body_rate.theory, pre.body_rate.measured
         angle = np.unwrap(np.arctan2(w[:, others[1]], w[:, others[0]]))
-        measured = estimators.body_precession_rate(t, w, ax_i)
-        lab = estimators.lab_precession_rate(t, q, w, moments, ax_i)
-        lab_theory = theory.lab_precession_rate(i_perp, float(g[0]))
         fig, ax = _figure('Body-frame precession of omega about the symmetry axis',
                           'time (s)', 'angle of omega_perp (rad)')
-        ax.plot(t, angle - angle[0], label=f'measured: {measured.rate:.10g} rad/s')
+        ax.plot(t, angle - angle[0], label=f'measured: {measured:.10g} rad/s')
         ax.plot(t, rate * (t - t[0]), '--', label=f'theory Omega = {rate:.10g} rad/s')
         ax.legend(loc='best')
         figures['precession'] = (_save(fig, out_dir, 'precession.png'),
                                  {'measured': angle - angle[0], 'theory': rate * (t - t[0])})
-        rows += [('body precession rate (rad/s)', f'{measured.rate:.10g}', f'{rate:.10g}'),
-                 ('lab precession rate (rad/s)', f'{lab.rate:.10g}', f'{lab_theory:.10g}')]
-    elif not inertia.is_spherical:
-        stab = theory.stability(moments, w[0])
+    elif stab.kind == 'unstable':
         mid = int(np.argsort(moments)[1])
-        flip = theory.flip_interval(moments, w[0])
+        flip = stab.flip_interval.theory
         fig, ax = _figure('Flips of the spin about the intermediate axis (tennis racket)',
                           'time (s)', f'omega_{mid + 1} (rad/s)')
         ax.plot(t, w[:, mid], label=f'omega_{mid + 1}')
         crossings = estimators.crossing_times(t, w[:, mid], direction=0)
         ax.plot(crossings, np.zeros_like(crossings), 'kx', label='flips (measured)')
-        if crossings.size and math.isfinite(flip):
+        if crossings.size and flip is not None and math.isfinite(flip):
             predicted = crossings[0] + flip * np.arange(crossings.size)
             ax.plot(predicted, np.zeros_like(predicted), 'o', mfc='none',
                     label=f'theory: every {flip:.6g} s')
         ax.legend(loc='best')
         figures['flips'] = (_save(fig, out_dir, 'flips.png'),
                             {'omega': w[:, mid], 'flips': crossings})
-        rows.append(('stability of the initial spin', stab.kind, f'axis {stab.axis + 1}'))
-        if crossings.size >= 2:
-            rows.append(('flip interval (s)', f'{np.diff(crossings).mean():.10g}',
-                         f'{flip:.10g}'))
+    rows = findings_rows(found)
     _write_html(run, out_dir, figures, rows)
     return figures, rows
+
+
+def findings_rows(found):
+    """Table rows (quantity, measured, theory) of the analysis' findings, as text."""
+    def text(x, fmt='.10g'):
+        return 'n/a' if x is None else format(x, fmt)
+
+    def qty(label, q):
+        if q is None:
+            return []
+        measured = text(q.measured) if q.measured is not None else f'not available: {q.why}'
+        return [(label, measured, text(q.theory))]
+    c, p, s = found.conservation, found.precession, found.stability
+    rows = []
+    if c.mode == 'free motion':
+        rows += [('largest energy drift (rel.)', f'{c.energy_drift:.2e}', '0'),
+                 ('largest |L| drift (rel.)', f'{c.momentum_drift:.2e}', '0'),
+                 ('largest L direction drift (rad)', f'{c.direction_drift:.2e}', '0')]
+    elif c.mode == 'balance laws':
+        rows += [('work-energy residual (rel.)', f'{c.energy_residual:.2e}', '0'),
+                 ('impulse-momentum residual (rel.)', f'{c.momentum_residual:.2e}', '0')]
+    rows += qty('body precession rate (rad/s)', p.body_rate)
+    rows += qty('lab precession rate (rad/s)', p.lab_rate)
+    rows += qty('period of omega (s)', p.omega_period)
+    if p.circled_axis is not None:
+        rows += qty(f'mean precession of axis {p.circled_axis + 1} about L (rad/s)',
+                    p.mean_precession)
+    if s.axis is not None:
+        rows.append(('stability of the spin', s.kind, f'axis {s.axis + 1}'))
+    rows += qty('growth rate (1/s)', s.growth_rate)
+    rows += qty('flip interval (s)', s.flip_interval)
+    rows += qty('wobble frequency (rad/s)', s.wobble_frequency)
+    return rows
 
 
 def _write_html(run, out_dir, figures, rows):
@@ -258,12 +256,13 @@ def _write_html(run, out_dir, figures, rows):
                        f'<figcaption>{name}</figcaption></figure>'
                        for name, (path, _) in figures.items())
     moments = ', '.join(f'{m:.6g}' for m in run.inertia.moments)
+    span = run.span
     page = f"""<!DOCTYPE html>
 <html><head><meta charset="utf-8"><title>rigid_body_dynamics: {html.escape(run.title)}</title>
 <style>body {{ font-family: sans-serif; max-width: 900px; margin: auto; }}
 td, th {{ padding: 2px 12px; text-align: left; }} img {{ max-width: 100%; }}</style></head>
 <body><h1>{html.escape(run.title)}</h1>
-<p>Principal moments {moments} kg m^2; {run.t.size} samples over {run.t[-1] - run.t[0]:.6g} s.</p>
+<p>Principal moments {moments} kg m^2; {len(run)} samples over {span:.6g} s.</p>
 <table><tr><th>quantity</th><th>measured</th><th>theory</th></tr>
 {table}
 </table>
@@ -279,16 +278,17 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description='Figures and an HTML page about a run.')
     source = parser.add_mutually_exclusive_group()
     source.add_argument('--preset', help='simulate this preset offline (default symmetric_top)')
-    source.add_argument('--recording', help='a .npz recording to report on')
-    source.add_argument('--record', help='record the running nodes into this .npz, then report')
+    source.add_argument('--bag', help='a rosbag2 folder or a .mcap / .db3 file to report on')
+    source.add_argument('--record', metavar='DIR', help='record the running nodes into a new '
+                        'rosbag2 bag (MCAP) in this folder, then report on it')
     parser.add_argument('--integrator', default='exact', choices=sorted(INTEGRATORS))
-    parser.add_argument('--duration', type=float, help='simulated / recorded seconds')
+    parser.add_argument('--duration', type=float, help='simulated / recorded seconds (of stamps)')
     parser.add_argument('--dt', type=float, default=1e-3, help='step (s), offline')
     parser.add_argument('--out', default='report', help='output folder (default ./report)')
     args = parser.parse_args(argv)
     try:
-        if args.recording:
-            run = load_recording(args.recording)
+        if args.bag:
+            run = read_trajectory(args.bag)[0]
         elif args.record:
             run = record(args.record, args.duration or 20.0)
         else:

@@ -1,10 +1,12 @@
-"""rigid_body_report: files, the data the figures show, recordings, clear errors."""
+"""rigid_body_report: files, the data the figures show, bags recorded and read, clear errors."""
 
 import os
 
 import numpy as np
 import pytest
+from bag_writers import rosbags_messages, write_rosbags
 from rigid_body_dynamics import report
+from rigid_body_dynamics.bags import read_trajectory
 from rigid_body_dynamics.physics import theory
 
 
@@ -37,22 +39,20 @@ def test_symmetric_report_has_precession_against_theory(tmp_path):
     assert measured['body precession rate (rad/s)'] == pytest.approx(1.0, rel=1e-12)
 
 
-def test_recording_round_trip_and_bad_recordings(tmp_path, capsys):
+def test_report_from_a_bag_and_bad_input(tmp_path, capsys):
     run = report.offline_run('stable_major', 'rk4', 5.0, 0.01)
-    path = str(tmp_path / 'run.npz')
-    report.save_recording(path, run)
-    assert report.main(['--recording', path, '--out', str(tmp_path / 'out')]) == 0
+    t_ns = 1_764_547_200_000_000_000 + run.t_ns
+    bag = write_rosbags(tmp_path / 'bag', rosbags_messages(
+        t_ns, run.q, run.omega, [1.0, 2.0, 3.0, 0.0, 0.0, 0.0]))
+    assert report.main(['--bag', str(bag), '--out', str(tmp_path / 'out')]) == 0
     assert 'wrote' in capsys.readouterr().out
-    loaded = report.load_recording(path)
-    np.testing.assert_array_equal(loaded.omega, run.omega)
-    garbage = tmp_path / 'garbage.npz'
-    garbage.write_bytes(b'not a recording')
-    assert report.main(['--recording', str(garbage)]) == 2
-    assert 'cannot read recording' in capsys.readouterr().err
-    np.savez(tmp_path / 'short.npz', t=np.zeros(2), q=np.zeros((2, 4)), omega=np.zeros((2, 3)),
-             tensor=np.eye(3))
-    assert report.main(['--recording', str(tmp_path / 'short.npz')]) == 2
-    assert 'N >= 3' in capsys.readouterr().err
+    figures, _ = report.make_report(report.read_trajectory(str(bag))[0], str(tmp_path / 'again'))
+    np.testing.assert_array_equal(figures['omega'][1]['omega_2'], run.omega[:, 1])
+    garbage = tmp_path / 'garbage.mcap'
+    garbage.write_bytes(b'not a bag')
+    assert report.main(['--bag', str(garbage)]) == 2
+    err = capsys.readouterr().err
+    assert 'not a readable rosbag2 bag or MCAP file' in err and len(err.splitlines()) == 1
     assert report.main(['--preset', 'boomerang']) == 2
     assert "unknown preset 'boomerang'" in capsys.readouterr().err
 
@@ -60,11 +60,16 @@ def test_recording_round_trip_and_bad_recordings(tmp_path, capsys):
 def test_record_from_the_running_simulator(launch, tmp_path):
     sim = launch('rigid_body_dynamics.nodes.simulator', '-p', 'publish_clock:=true',
                  '-p', 'real_time_factor:=4.0', name='sim')
-    path = str(tmp_path / 'live.npz')
-    assert report.main(['--record', path, '--duration', '3', '--out', str(tmp_path / 'r')]) == 0
-    run = report.load_recording(path)
-    assert run.t[-1] - run.t[0] >= 3.0
+    path = tmp_path / 'live'
+    assert report.main(['--record', str(path), '--duration', '3', '--out',
+                        str(tmp_path / 'r')]) == 0
+    assert sorted(os.listdir(path)) == ['live.mcap', 'metadata.yaml']
+    run, info = read_trajectory(str(path))
+    assert run.span >= 3.0 and (info.odom_topic, info.torque_topic) == ('/odom', '/applied_torque')
     np.testing.assert_allclose(run.inertia.moments, [1.0, 1.0, 1.5])
     assert os.path.exists(tmp_path / 'r' / 'precession.png')
+    # the latched inertia is recorded latched, so `ros2 bag play` latches it again
+    meta = open(path / 'metadata.yaml').read()
+    assert 'transient_local' in meta.lower() or 'durability: 1' in meta
     code, _ = sim.stop()
     assert code == 0
