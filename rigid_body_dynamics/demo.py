@@ -17,52 +17,21 @@ import subprocess
 import sys
 import time
 
-import numpy as np
-
-from .physics import estimators, FreeRigidBody, INTEGRATORS, presets, quaternions, simulate, theory
-
-
-def _line(label, measured, predicted, unit):
-    rel = abs(measured - predicted) / abs(predicted) if predicted else float('nan')
-    return f'  {label:<34} {measured:>+.10f} {unit:<6} theory {predicted:>+.10f}  (rel. {rel:.1e})'
+from .physics import FreeRigidBody, INTEGRATORS, presets, quaternions, simulate
+from .physics.analysis import analyse, quantity_lines, Trajectory
 
 
 def report(preset, integrator, duration, dt):
-    """Simulate ``preset`` offline and compare with theory; returns the lines."""
+    """Simulate ``preset`` offline and analyse it (the one analysis); returns the lines."""
     body = presets.get(preset)
-    moments = np.array(body.moments)
-    run = simulate(moments, body.omega0, body.q0, duration, dt, integrator=integrator)
-    lines = [f'{body.name}: {body.description}',
-             f'  I = {body.moments} kg m^2, omega0 = {body.omega0} rad/s body, '
-             f'{integrator}, dt = {dt} s, {run.t[-1] - run.t[0]:.4g} s of samples']
-    shape_axis = FreeRigidBody(moments, body.omega0).shape.axis
-    if shape_axis is not None:
-        ax = shape_axis
-        i_perp = moments[(ax + 1) % 3]
-        g = float(np.linalg.norm(moments * body.omega0))
-        lines.append(_line('body precession Omega (rad/s)',
-                           estimators.body_precession_rate(run.t, run.omega, ax).rate,
-                           theory.body_precession_rate(i_perp, moments[ax], body.omega0[ax]), ''))
-        lab = estimators.lab_precession_rate(run.t, run.q, run.omega, moments, ax)
-        lines.append(_line('lab precession |L|/I1 (rad/s)', lab.rate,
-                           theory.lab_precession_rate(i_perp, g), ''))
-    else:
-        st = theory.stability(moments, body.omega0)
-        lines.append(f'  spin about axis {st.axis + 1}: {st.kind}'
-                     + (f', growth rate {st.rate:.6f} 1/s' if st.kind == 'unstable' else
-                        f', wobble {st.rate:.6f} rad/s'))
-        period = theory.omega_period(moments, body.omega0)
-        if np.isfinite(period) and duration > 2.0 * period:
-            mid = int(np.argsort(moments)[1])
-            lines.append(_line('flip interval (s)',
-                               0.5 * estimators.crossing_period(run.t, run.omega[:, mid], 0),
-                               theory.flip_interval(moments, body.omega0), ''))
-    cons = estimators.conservation(run.t, run.q, run.omega, moments)
-    exact_q, _ = FreeRigidBody(moments, body.omega0, body.q0).state_at(run.t[-1])
-    lines.append(f'  conservation: energy {cons.energy:.1e}, |L| {cons.momentum:.1e} (relative), '
-                 f'L direction {cons.direction:.1e} rad; attitude vs exact '
-                 f'{float(quaternions.angle_between(run.q[-1], exact_q)):.1e} rad')
-    return lines
+    run = simulate(body.moments, body.omega0, body.q0, duration, dt, integrator=integrator)
+    found = analyse(Trajectory.from_simulation(run))
+    exact_q, _ = FreeRigidBody(body.moments, body.omega0, body.q0).state_at(run.t[-1])
+    return [f'{body.name}: {body.description}',
+            f'  I = {body.moments} kg m^2, omega0 = {body.omega0} rad/s body, '
+            f'{integrator}, dt = {dt} s; the analysis finds:'] + found.lines()[1:] + [
+        f'  attitude at the end vs the exact solution: '
+        f'{float(quaternions.angle_between(run.q[-1], exact_q)):.1e} rad']
 
 
 #: What the demo waits for in the analyzer's diagnostics, per kind of body.
@@ -72,39 +41,38 @@ _READY = {
 }
 
 
-def _number(text):
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return None
-
-
 def findings(statuses):
-    """Readable lines from the analyzer's newest statuses (name -> (level, message, values))."""
+    """
+    Lines from the analyzer's newest statuses (name -> (level, message, values)).
+
+    The values are read back by key into the analysis' quantities and
+    printed with the same formatter as the offline analysis.
+    """
+    from .nodes import diagnostics
     lines = []
     pre = statuses.get('precession')
-    if pre and 'body rate, measured (rad/s)' in pre[2]:
+    if pre:
         v = pre[2]
-        for label, key in (('body precession Omega (rad/s)', 'body rate'),
-                           ('lab precession |L|/I1 (rad/s)', 'lab rate')):
-            lines.append(_line(label, float(v[f'{key}, measured (rad/s)']),
-                               float(v[f'{key}, theory (rad/s)']), ''))
+        axis = next((k.split(' about L')[0].rsplit(' ', 1)[1] for k in v
+                     if k.startswith('mean precession of axis')), None)
+        for label, key, unit in (('body precession Omega (rad/s)', 'body rate', 'rad/s'),
+                                 ('lab precession |L|/I_perp (rad/s)', 'lab rate', 'rad/s'),
+                                 ('period of omega (s)', 'omega period', 's'),
+                                 (f'mean precession of axis {axis} (rad/s)',
+                                  f'mean precession of axis {axis} about L', 'rad/s')):
+            lines += quantity_lines(label, diagnostics.quantity_from(v, key, unit))
     stab = statuses.get('stability')
     if stab:
-        v = stab[2]
         lines.append(f'  stability: {stab[1]}')
-        for label, key in (('growth rate (1/s)', 'growth rate'),
-                           ('flip interval (s)', 'flip interval')):
-            unit = '(1/s)' if key == 'growth rate' else '(s)'
-            measured = _number(v.get(f'{key}, measured {unit}'))
-            if measured is not None:
-                lines.append(_line(label, measured, float(v[f'{key}, theory {unit}']), ''))
+        for label, key, unit in (('growth rate (1/s)', 'growth rate', '1/s'),
+                                 ('flip interval (s)', 'flip interval', 's')):
+            lines += quantity_lines(label, diagnostics.quantity_from(stab[2], key, unit))
     cons = statuses.get('conservation')
     if cons:
         v = cons[2]
         drift = ', '.join(f'{k.split(" since")[0]} {float(v[k]):.1e}' for k in v
                           if 'since baseline' in k)
-        lines.append(f'  conservation: {cons[1]} ({drift})')
+        lines.append(f'  conservation: {cons[1]}' + (f' ({drift})' if drift else ''))
     return lines
 
 
@@ -154,7 +122,7 @@ def run_nodes(preset, integrator, rate):
                 values = status_values(st)
                 name = st.name.split(': ', 1)[1]
                 statuses[name] = (st.level, st.message, values)
-                if key in values and _number(values[key]) is not None:
+                if key in values and _is_number(values[key]):
                     first.setdefault(name, time.monotonic())
     node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 10)
     deadline = time.monotonic() + 60.0 + window / rtf
@@ -189,6 +157,14 @@ def run_nodes(preset, integrator, rate):
     lines.append(f'  stopped attitude_analyzer and attitude_simulator (exit codes {codes[0]}, '
                  f'{codes[1]})')
     return lines
+
+
+def _is_number(text):
+    try:
+        float(text)
+    except (TypeError, ValueError):
+        return False
+    return True
 
 
 def _ros_environment():

@@ -91,3 +91,27 @@ def stability(found, name, hardware_id):
             values += quantity('wobble frequency', found.wobble_frequency)
     return status(f'{name}: stability', LEVELS[found.status], found.message, values,
                   hardware_id)
+
+
+def _number(text):
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return None
+
+
+def quantity_from(values, label, unit):
+    """
+    The :class:`~rigid_body_dynamics.physics.analysis.Quantity` that :func:`quantity` wrote.
+
+    ``values`` is a status' key -> string mapping; None when the label is absent.
+    """
+    suffix = f' ({unit})' if unit else ''
+    measured = values.get(f'{label}, measured{suffix}')
+    if measured is None:
+        return None
+    number = _number(measured)
+    why = '' if number is not None else str(measured).replace('not available: ', '', 1)
+    return analysis.Quantity(number, _number(values.get(f'{label}, theory{suffix}')),
+                             values.get(f'{label} status', analysis.OK if number is not None
+                                        else analysis.UNAVAILABLE), unit, why=why)

@@ -327,45 +327,50 @@ class Findings:
 
     def lines(self):
         """Readable lines: each measured number beside theory, statuses and reasons."""
-        def row(label, qty):
-            if qty is None:
-                return []
-            if qty.measured is None:
-                theory_text = '' if qty.theory is None else f' (theory {qty.theory:.10g})'
-                return [f'  {label:<36} not available: {qty.why}{theory_text}']
-            if qty.theory is None:
-                return [f'  {label:<36} {qty.measured:>+.10f}']
-            rel = qty.relative_error
-            rel_text = '' if rel is None else f'  (rel. {rel:.1e}, {qty.status})'
-            return [f'  {label:<36} {qty.measured:>+.10f}  theory {qty.theory:>+.10f}{rel_text}']
         c, p, s = self.conservation, self.precession, self.stability
         out = [f'  {self.samples} samples over {self.span:.6g} s']
         if p.kind == 'axisymmetric':
-            out += row('body precession Omega (rad/s)', p.body_rate)
-            out += row('lab precession |L|/I_perp (rad/s)', p.lab_rate)
+            out += quantity_lines('body precession Omega (rad/s)', p.body_rate)
+            out += quantity_lines('lab precession |L|/I_perp (rad/s)', p.lab_rate)
         elif p.kind == 'asymmetric':
-            out += row('period of omega (s)', p.omega_period)
+            out += quantity_lines('period of omega (s)', p.omega_period)
             if p.circled_axis is not None:
-                out += row(f'mean precession of axis {p.circled_axis + 1} (rad/s)',
-                           p.mean_precession)
+                out += quantity_lines(f'mean precession of axis {p.circled_axis + 1} (rad/s)',
+                                      p.mean_precession)
         else:
             out.append(f'  precession: {p.message}')
         out.append(f'  stability: {s.message}')
-        for label, qty in (('growth rate (1/s)', s.growth_rate),
-                           ('flip interval (s)', s.flip_interval),
-                           ('wobble frequency (rad/s)', s.wobble_frequency)):
-            if qty is not None and (qty.measured is not None or qty.theory is not None):
-                out += row(label, qty)
-        if c.mode == 'free motion':
-            out.append(f'  conservation: {c.message} (energy drift {c.energy_drift:.1e}, |L| '
-                       f'drift {c.momentum_drift:.1e}, L direction drift '
-                       f'{c.direction_drift:.1e} rad)')
-        elif c.mode == 'balance laws':
-            out.append(f'  conservation under torque: {c.message} (work-energy residual '
-                       f'{c.energy_residual:.1e}, impulse-momentum {c.momentum_residual:.1e})')
-        else:
-            out.append(f'  conservation: {c.message}')
+        out += quantity_lines('growth rate (1/s)', s.growth_rate)
+        out += quantity_lines('flip interval (s)', s.flip_interval)
+        if p.body_rate is None:            # a top's wobble is its Omega, printed above
+            out += quantity_lines('wobble frequency (rad/s)', s.wobble_frequency)
+        out.append(conservation_line(c))
         return out
+
+
+def quantity_lines(label, qty):
+    """One aligned line for a :class:`Quantity` (none when there is nothing to say)."""
+    if qty is None or (qty.measured is None and qty.theory is None):
+        return []
+    if qty.measured is None:
+        theory_text = '' if qty.theory is None else f' (theory {qty.theory:.10g})'
+        return [f'  {label:<36} not available: {qty.why}{theory_text}']
+    if qty.theory is None:
+        return [f'  {label:<36} {qty.measured:>+.10f}']
+    rel = qty.relative_error
+    rel_text = '' if rel is None else f'  (rel. {rel:.1e}, {qty.status})'
+    return [f'  {label:<36} {qty.measured:>+.10f}  theory {qty.theory:>+.10f}{rel_text}']
+
+
+def conservation_line(c):
+    """One line for :class:`ConservationFindings`."""
+    if c.mode == 'free motion':
+        return (f'  conservation: {c.message} (energy drift {c.energy_drift:.1e}, |L| drift '
+                f'{c.momentum_drift:.1e}, L direction drift {c.direction_drift:.1e} rad)')
+    if c.mode == 'balance laws':
+        return (f'  conservation under torque: {c.message} (work-energy residual '
+                f'{c.energy_residual:.1e}, impulse-momentum {c.momentum_residual:.1e})')
+    return f'  conservation: {c.message}'
 
 
 def analyse(trajectory, baseline=None, tolerances=Tolerances()):
