@@ -85,8 +85,8 @@ def open_reader(path):
     p = Path(path)
     if not p.exists():
         raise BagError(f'{path}: no such file or folder')
-    reader = AnyReader([p], default_typestore=_typestore())
     try:
+        reader = AnyReader([p], default_typestore=_typestore())
         reader.open()
     except Exception as err:   # rosbags raises several types (and struct/OS errors) here
         raise BagError(f'{path}: not a readable rosbag2 bag or MCAP file '

@@ -305,10 +305,10 @@ class AttitudeAnalyzer(Node):
         s = self._settings
         name = self.get_name()
         hw = self.get_fully_qualified_name()
-        statuses = [self._input_status(name, hw)]
         buf = self._buffer
         if buf.t:
             buf.trim(buf.t[-1] - int(s['window'] * 1e9))
+        statuses = [self._input_status(name, hw)]
         checks = ('conservation', 'precession', 'stability')
         if self._inertia is None:
             text = 'no inertia yet: set the inertia parameter or publish the inertia topic'
@@ -359,7 +359,11 @@ class AttitudeAnalyzer(Node):
                   ('dropped non-finite samples', self._restarts['non_finite']),
                   ('dropped samples in another frame', self._restarts['wrong_frame']),
                   ('inertia source', self._inertia_source or 'none'),
-                  ('body frame', self._body_frame or 'any')]
+                  ('body frame', self._body_frame or 'any'),
+                  ('samples in the window', len(self._buffer.t))]
+        if self._buffer.t:
+            values += [('window first stamp (ns)', self._buffer.t[0]),
+                       ('window last stamp (ns)', self._buffer.t[-1])]
         if self._last_arrival is None:
             return conv.status(f'{name}: input', STALE, 'no odom received yet', values, hw)
         age = (now - self._last_arrival) * 1e-9

@@ -109,7 +109,7 @@ class Trajectory:
         """Keep the samples with start <= t - t_first <= end (s from the first stamp)."""
         if not len(self):
             return self
-        rel = (self.t_ns - self.t_ns[0]).astype(float) * 1e-9
+        rel = (self.t_ns - self.t_ns[0]).astype(float) / 1e9
         keep = np.ones(len(self), dtype=bool)
         if start is not None:
             keep &= rel >= start
