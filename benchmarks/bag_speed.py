@@ -22,7 +22,7 @@ MESSAGES = 1_000_000
 def make_bag(path, messages=MESSAGES):
     """Write the bag; returns seconds taken."""
     import numpy as np
-    from bag_writers import rosbags_messages, write_rosbags
+    from bag_writers import rosbags_messages
     from rigid_body_dynamics.physics import presets, simulate
     body = presets.get('tennis_racket')
     start = time.perf_counter()

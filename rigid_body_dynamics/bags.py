@@ -53,7 +53,7 @@ def _namespace(topic):
 
 
 def _pick(connections, wanted, msgtype, role, default_name=None, near=None):
-    """The connection for ``role``: the named topic, or the only one of its type (or None)."""
+    """Pick the topic for ``role``: the named one, or the only one of its type (or None)."""
     by_topic = {}
     for c in connections:
         by_topic.setdefault(c.topic, c.msgtype)
@@ -80,7 +80,7 @@ def _pick(connections, wanted, msgtype, role, default_name=None, near=None):
 
 
 def open_reader(path):
-    """An open rosbags AnyReader on a bag folder or a bare .mcap / .db3 file; BagError if not."""
+    """Open a rosbags AnyReader on a bag folder or a bare .mcap / .db3 file; BagError if not."""
     from rosbags.highlevel import AnyReader
     p = Path(path)
     if not p.exists():
@@ -254,7 +254,8 @@ def _odometry(reader, raws, body_frame, info):
         try:
             st, sq, sw = samples.odometry_sample(reader.deserialize(raw, ODOMETRY), body_frame)
         except samples.FrameError:
-            info.dropped['odom in another frame'] = info.dropped.get('odom in another frame', 0) + 1
+            info.dropped['odom in another frame'] = \
+                info.dropped.get('odom in another frame', 0) + 1
             continue
         t.append(st)
         q.append(sq)
@@ -303,7 +304,7 @@ def _torques(reader, raws, body_frame, info):
 # ---------------------------------------------------------------------------- writing
 
 def latched_qos():
-    """The QoS of a latched topic (transient local, depth 1) as rosbags records it."""
+    """Return the QoS of a latched topic (transient local, depth 1) as rosbags records it."""
     from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness,
                                     QosReliability, QosTime)
     zero = QosTime(0, 0)
@@ -312,7 +313,7 @@ def latched_qos():
 
 
 def stream_qos():
-    """Reliable, volatile, keep-last QoS for state and torque topics."""
+    """Return the reliable, volatile, keep-last QoS of the state and torque topics."""
     from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness,
                                     QosReliability, QosTime)
     zero = QosTime(0, 0)

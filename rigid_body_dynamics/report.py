@@ -29,12 +29,12 @@ import time
 import numpy as np
 
 from .bags import BagError, BagWriter, INERTIA, ODOMETRY, read_trajectory, WRENCH
-from .physics import estimators, INTEGRATORS, presets, quaternions, simulate, theory
+from .physics import estimators, INTEGRATORS, presets, quaternions, simulate
 from .physics.analysis import analyse, drift_series, Trajectory
 
 
 def offline_run(preset, integrator, duration, dt, progress=None):
-    """Simulate a preset; ``progress(fraction)`` is called as the run goes. Returns a Trajectory."""
+    """Simulate a preset into a Trajectory; ``progress(fraction)`` is called as it goes."""
     body = presets.get(preset)
     result = simulate(body.moments, body.omega0, body.q0, duration, dt, integrator=integrator,
                       progress=progress)

@@ -66,7 +66,7 @@ def torque_sample(msg, body_frame=None):
 
 
 def inertia_tensor(msg):
-    """Return ([Ixx, Iyy, Izz, Ixy, Ixz, Iyz] kg m^2, frame id) of a geometry_msgs/InertiaStamped."""
+    """Return ([Ixx, Iyy, Izz, Ixy, Ixz, Iyz] kg m^2, frame id) of an InertiaStamped."""
     i = msg.inertia
     return [i.ixx, i.iyy, i.izz, i.ixy, i.ixz, i.iyz], msg.header.frame_id
 

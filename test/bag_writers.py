@@ -23,13 +23,13 @@ def _stamp(cls, t_ns):
 
 
 def rosbags_messages(t_ns, q, w, tensor, torque=None, child=BODY_FRAME, inertia_frame=BODY_FRAME):
-    """Serialised (topic, t_ns, cdr) in publishing order, made with rosbags' typestore."""
+    """Serialise messages with rosbags' typestore: (topic, t_ns, cdr) in publishing order."""
     store = bags._typestore()
     T = store.types
     Time = T['builtin_interfaces/msg/Time']
     Header = T['std_msgs/msg/Header']
-    Vector3, Quaternion, Point = (T['geometry_msgs/msg/Vector3'], T['geometry_msgs/msg/Quaternion'],
-                                  T['geometry_msgs/msg/Point'])
+    Vector3 = T['geometry_msgs/msg/Vector3']
+    Quaternion, Point = T['geometry_msgs/msg/Quaternion'], T['geometry_msgs/msg/Point']
     Pose, Twist = T['geometry_msgs/msg/Pose'], T['geometry_msgs/msg/Twist']
     PoseCov, TwistCov = (T['geometry_msgs/msg/PoseWithCovariance'],
                          T['geometry_msgs/msg/TwistWithCovariance'])
@@ -47,18 +47,16 @@ def rosbags_messages(t_ns, q, w, tensor, torque=None, child=BODY_FRAME, inertia_
         header = Header(stamp=_stamp(Time, t), frame_id=ODOM_FRAME)
         odom = Odometry(
             header=header, child_frame_id=child,
-            pose=PoseCov(pose=Pose(position=Point(x=0.0, y=0.0, z=0.0),
-                                   orientation=Quaternion(x=q[k][0], y=q[k][1], z=q[k][2],
-                                                          w=q[k][3])), covariance=cov),
-            twist=TwistCov(twist=Twist(linear=zero3, angular=Vector3(x=w[k][0], y=w[k][1],
-                                                                      z=w[k][2])),
-                           covariance=cov))
+            pose=PoseCov(pose=Pose(position=Point(x=0.0, y=0.0, z=0.0), orientation=Quaternion(
+                x=q[k][0], y=q[k][1], z=q[k][2], w=q[k][3])), covariance=cov),
+            twist=TwistCov(twist=Twist(linear=zero3, angular=Vector3(
+                x=w[k][0], y=w[k][1], z=w[k][2])), covariance=cov))
         out.append(('odom', int(t), store.serialize_cdr(odom, bags.ODOMETRY)))
         if torque is not None:
             tau = torque[k]
             msg = WrenchStamped(header=Header(stamp=_stamp(Time, t), frame_id=BODY_FRAME),
-                                wrench=Wrench(force=zero3, torque=Vector3(x=tau[0], y=tau[1],
-                                                                           z=tau[2])))
+                                wrench=Wrench(force=zero3, torque=Vector3(
+                                    x=tau[0], y=tau[1], z=tau[2])))
             out.append(('applied_torque', int(t), store.serialize_cdr(msg, bags.WRENCH)))
     return out
 
@@ -116,7 +114,7 @@ def _dependencies(name, seen):
 
 
 def msgdef(name):
-    """The ros2msg definition text of ``name`` (pkg/msg/Type) with its dependencies."""
+    """Return the ros2msg definition text of ``name`` (pkg/msg/Type) with its dependencies."""
     text = _msg_text(name)
     for dep in _dependencies(name, []):
         short = dep.replace('/msg/', '/')

@@ -203,6 +203,8 @@ def test_start_end_cut_the_samples(racket, tmp_path):
 
 def test_live_analyzer_and_rigid_body_analyze_agree_on_the_same_stamps(launch, probe, tmp_path):
     """
+    Compare the live analyzer with rigid_body_analyze on one window of a recorded bag.
+
     The nodes run; rigid_body_report --record writes a bag meanwhile; for an analysis tick whose
     window lies inside the bag, rigid_body_analyze on that window's stamps gives the analyzer's
     rates to 1e-9.

@@ -2,9 +2,9 @@
 
 import os
 
+from bag_writers import rosbags_messages, write_rosbags
 import numpy as np
 import pytest
-from bag_writers import rosbags_messages, write_rosbags
 from rigid_body_dynamics import report
 from rigid_body_dynamics.bags import read_trajectory
 from rigid_body_dynamics.physics import theory

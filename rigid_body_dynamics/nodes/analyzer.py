@@ -9,9 +9,13 @@ times: samples are kept sorted by stamp, duplicates dropped; a stamp more than
 longer than ``max_gap`` s restarts the estimates instead of corrupting them.
 
 Every ``diagnostic_period`` (steady clock) the samples of the last ``window``
-s (by stamp) are analysed with :mod:`rigid_body_dynamics.physics.estimators`
-and compared with :mod:`rigid_body_dynamics.physics.theory`. Until there is
-enough data a measurement is reported as not available, never as a number.
+s (by stamp) go to :func:`rigid_body_dynamics.physics.analysis.analyse`, the
+one analysis every door shares, and its findings are formatted by
+:mod:`.diagnostics`. Odometry is read by :mod:`rigid_body_dynamics.samples`
+(twist frames honoured; stamps as integer ns). Free-motion drift is measured
+from the first sample by stamp of the current torque-free segment, kept here
+because the window may have dropped it. Until there is enough data a
+measurement is reported as not available, never as a number.
 """
 
 import bisect
@@ -95,7 +99,7 @@ class SampleBuffer:
         self.torque.insert(i, torque)
 
     def first_from(self, t):
-        """The earliest state sample (t, q, w) with stamp >= t (ns), or None."""
+        """Return the earliest state sample (t, q, w) with stamp >= t (ns), or None."""
         i = bisect.bisect_left(self.t, t)
         return (self.t[i], self.q[i], self.w[i]) if i < len(self.t) else None
 

@@ -102,7 +102,7 @@ def _number(text):
 
 def quantity_from(values, label, unit):
     """
-    The :class:`~rigid_body_dynamics.physics.analysis.Quantity` that :func:`quantity` wrote.
+    Read back the :class:`~rigid_body_dynamics.physics.analysis.Quantity` that quantity() wrote.
 
     ``values`` is a status' key -> string mapping; None when the label is absent.
     """

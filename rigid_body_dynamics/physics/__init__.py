@@ -2,15 +2,16 @@
 Physics of the free and torqued rigid body: numpy/scipy only, never ROS.
 
 Public API (stable): :class:`Inertia`, :class:`FreeRigidBody`,
-:func:`simulate`, the modules :mod:`theory`, :mod:`estimators`,
-:mod:`presets`, and :data:`INTEGRATORS` / :func:`make_integrator`.
+:func:`simulate`, the modules :mod:`analysis` (the one analysis),
+:mod:`theory`, :mod:`estimators`, :mod:`presets`, :mod:`control`, and
+:data:`INTEGRATORS` / :func:`make_integrator`.
 """
 
-from . import estimators, presets, theory
+from . import analysis, control, estimators, presets, theory
 from .free_motion import FreeRigidBody
 from .inertia import Inertia
 from .integrators import INTEGRATORS, make_integrator
 from .simulation import simulate, SimulationResult
 
-__all__ = ['estimators', 'FreeRigidBody', 'Inertia', 'INTEGRATORS', 'make_integrator',
-           'presets', 'simulate', 'SimulationResult', 'theory']
+__all__ = ['analysis', 'control', 'estimators', 'FreeRigidBody', 'Inertia', 'INTEGRATORS',
+           'make_integrator', 'presets', 'simulate', 'SimulationResult', 'theory']
