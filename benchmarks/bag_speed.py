@@ -3,7 +3,7 @@ rigid_body_analyze on a bag of 1e6 nav_msgs/Odometry messages (MCAP): wall time 
 
 The bag (tennis racket at 1 kHz for 1000 s, plus applied_torque and the
 latched inertia, written with rosbags through the package's BagWriter) is made
-once in a temporary folder. Timed: the whole ``rigid_body_analyze`` run in a
+in a temporary folder, removed afterwards. Timed: the whole ``rigid_body_analyze`` run in a
 fresh process, and inside it reading + deserialising, samples, analysis.
 """
 
@@ -43,8 +43,11 @@ def make_bag(path, messages=MESSAGES):
 
 def measure():
     """Lines for RESULTS.md."""
-    folder = tempfile.mkdtemp(prefix='rbd-bag-')
-    path = os.path.join(folder, 'bag')
+    with tempfile.TemporaryDirectory(prefix='rbd-bag-') as folder:
+        return _measure(os.path.join(folder, 'bag'))
+
+
+def _measure(path):
     made = make_bag(path)
     size = sum(os.path.getsize(os.path.join(path, f)) for f in os.listdir(path))
     start = time.perf_counter()
