@@ -58,6 +58,10 @@ def _spin(nodes, stop):
     wake.trigger()
     thread.join()
     nodes[0].destroy_guard_condition(wake)
+    # destroy the executor's guard conditions now, while the context is alive: left to
+    # its __del__ they may be collected after the shutdown ("Exception ignored in
+    # Executor.__del__", seen at SIGTERM)
+    executor.shutdown(timeout_sec=1.0)
     if failure:
         raise failure[0]
 

@@ -1,0 +1,278 @@
+"""
+One simulated body, without ROS: integrator, held torque command, watchdog, clip, counters.
+
+``attitude_simulator`` and ``attitude_fleet`` wrap one ``BodySimulation``
+per body; everything here is plain Python on the physics layer, so it is
+unit-tested on a fake clock (test/test_engine.py). Times: ``now_ns`` is the
+steady clock (int ns) the caller passes in, never read here; the simulated
+time is an integer step count times dt, and snapshots carry the stamp
+``start_ns + int(steps * dt_ns)`` (int ns) their messages will have.
+
+Frames: the body frame is the user's (the inertia's); the state is kept in
+the principal frame of the inertia. Torques in N m, body frame, or world frame
+for a command given in the world frame (rotated into the body at every RK
+stage by the integrator).
+"""
+
+from dataclasses import dataclass
+import math
+import threading
+
+import numpy as np
+
+from ..physics import make_integrator, quaternions
+
+_ZERO = (0.0, 0.0, 0.0)
+_NS = 1_000_000_000
+
+#: Counters of torque commands, in the order diagnostics list them.
+COUNTS = ('accepted', 'rejected_non_finite', 'rejected_frame', 'clipped', 'force_ignored')
+
+
+@dataclass(frozen=True)
+class TorqueCommand:
+    """The held command: ``vector`` (N m), body or ``world`` frame, steady receive time (ns)."""
+
+    vector: tuple
+    world: bool
+    received_ns: int
+    principal: object   # the body vector in the principal frame (None for a world command)
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """
+    What one publish tick needs, taken under the lock.
+
+    ``stamp_ns`` (int ns: start + simulated time), ``steps``, principal-frame
+    ``q`` (x, y, z, w) and ``omega`` (rad/s), the principal-frame ``torque``
+    (N m) integrated over the step that ended here, and the ``inertia``.
+    """
+
+    stamp_ns: int
+    steps: int
+    q: tuple
+    omega: tuple
+    torque: tuple
+    inertia: object
+
+
+class BodySimulation:
+    """
+    The state of one simulated body and the rules for changing it.
+
+    ``inertia`` (Inertia), ``integrator`` (a name from INTEGRATORS), ``rate``
+    (Hz; dt = 1 / rate), ``initial`` = (q0 x-y-z-w, omega0 rad/s) in the body
+    frame, ``torque_timeout`` (s; 0 = hold forever), ``max_torque`` (N m per
+    axis; 0 = no limit), ``publish_every`` (steps per publish tick),
+    ``start_ns`` (stamp of simulated time 0). ``lock`` guards every change;
+    the methods take it themselves. ``notes`` collects what a node should
+    log (the watchdog's timeouts), drained with :meth:`take_notes`.
+    """
+
+    def __init__(self, inertia, integrator, rate, initial, torque_timeout=0.5, max_torque=0.0,
+                 publish_every=1, start_ns=0):
+        self.lock = threading.RLock()
+        self.rate = float(rate)
+        self.dt = 1.0 / self.rate
+        self.dt_ns = _NS / self.rate
+        self.start_ns = int(start_ns)
+        self.inertia = inertia
+        self.integrator_name = integrator
+        self.initial = initial
+        self.timeout_ns = int(torque_timeout * _NS)
+        self.max_torque = float(max_torque)
+        self.publish_every = int(publish_every)
+        self.counts = dict.fromkeys(COUNTS, 0)
+        self.notes = []
+        self.reset()
+
+    # ------------------------------------------------------------------ state
+    def reset(self):
+        """Back to the initial state at simulated time 0, no command, not paused."""
+        with self.lock:
+            q0, w0 = self.initial
+            body = self.inertia
+            self.stepper = make_integrator(self.integrator_name, body.moments, self.dt,
+                                           body.attitude_to_principal(np.asarray(q0, float)),
+                                           body.to_principal(np.asarray(w0, float)))
+            self.steps = 0
+            self.paused = False
+            self.command_held = None
+            self.timed_out = False
+            self.last_torque = _ZERO
+            self._baseline()
+
+    def _baseline(self):
+        """Remember T and L_w now: drift is reported since the last torque or change."""
+        self.base = self.invariants()
+
+    def invariants(self):
+        """(T in J, L_w in kg m^2/s, world frame) of the current state."""
+        s = self.stepper
+        return s.kinetic_energy, s.angular_momentum_world
+
+    def body_state(self):
+        """(q, omega) of the user's body frame as arrays."""
+        s, body = self.stepper, self.inertia
+        return body.attitude_to_body(np.array(s.q)), body.to_body(np.array(s.omega))
+
+    def set_paused(self, paused):
+        """Freeze (True) or resume (False); returns whether it was paused before."""
+        with self.lock:
+            was, self.paused = self.paused, bool(paused)
+            return was
+
+    # ------------------------------------------------------------------ configuration
+    def configure(self, inertia=None, integrator=None, initial=None, torque_timeout=None,
+                  max_torque=None, publish_every=None):
+        """
+        Take validated settings into effect; returns lines saying what changed.
+
+        A new inertia keeps the body-frame attitude and angular velocity; a new
+        integrator continues from the current state; both restart the drift
+        baseline and keep the held command (re-expressed in the new frame).
+        """
+        lines = []
+        with self.lock:
+            if initial is not None:
+                self.initial = initial
+            if torque_timeout is not None:
+                self.timeout_ns = int(torque_timeout * _NS)
+            if max_torque is not None:
+                self.max_torque = float(max_torque)
+            if publish_every is not None:
+                self.publish_every = int(publish_every)
+            rebuild = False
+            if inertia is not None and inertia is not self.inertia:
+                q_b, w_b = self.body_state()
+                self.inertia = inertia
+                self.stepper.reset(inertia.attitude_to_principal(q_b), inertia.to_principal(w_b))
+                rebuild = True
+                lines.append(f'inertia now {inertia.moments.tolist()} kg m^2 ({inertia.kind}); '
+                             'attitude and angular velocity kept')
+            if integrator is not None and integrator != self.integrator_name:
+                self.integrator_name = integrator
+                rebuild = True
+                lines.append(f'integrator now {integrator}, continuing from the current state')
+            if rebuild:
+                self.stepper = make_integrator(self.integrator_name, self.inertia.moments,
+                                               self.dt, self.stepper.q, self.stepper.omega)
+                self._baseline()
+                cmd = self.command_held
+                if cmd is not None:
+                    self.command_held = self._make_command(cmd.vector, cmd.world,
+                                                           cmd.received_ns)
+        return lines
+
+    # ------------------------------------------------------------------ torque
+    def _make_command(self, vector, world, received_ns):
+        principal = None if world else tuple(
+            float(c) for c in self.inertia.to_principal(np.array(vector)))
+        return TorqueCommand(tuple(vector), world, received_ns, principal)
+
+    def command(self, vector, world, now_ns, force=_ZERO):
+        """
+        Take a torque command (N m, in the body or, if ``world``, the world frame) and hold it.
+
+        A non-finite torque is refused and counted (returns 'rejected_non_finite',
+        the state untouched); a component beyond ``max_torque`` is clipped and
+        counted; a force is ignored and counted. Returns the list of what
+        happened: any of 'clipped', 'force_ignored', and 'accepted'.
+        """
+        vector = tuple(float(c) for c in vector)
+        with self.lock:
+            if not all(math.isfinite(c) for c in vector):
+                self.counts['rejected_non_finite'] += 1
+                return ['rejected_non_finite']
+            events = []
+            limit = self.max_torque
+            if limit > 0.0 and any(abs(c) > limit for c in vector):
+                vector = tuple(min(max(c, -limit), limit) for c in vector)
+                events.append('clipped')
+            if not all(math.isfinite(c) for c in force) or any(force):
+                events.append('force_ignored')
+            events.append('accepted')
+            for event in events:
+                self.counts[event] += 1
+            self.command_held = self._make_command(vector, bool(world), int(now_ns))
+            return events
+
+    def reject(self, reason):
+        """Count a command refused before it got here (e.g. 'rejected_frame')."""
+        with self.lock:
+            self.counts[reason] += 1
+
+    def torque_now(self, now_ns):
+        """
+        Torque for the next step: (principal-frame part, world-frame part or None).
+
+        Zero once ``torque_timeout`` has passed since the command arrived (a
+        note says so once per timeout).
+        """
+        cmd = self.command_held
+        if cmd is None:
+            return _ZERO, None
+        if self.timeout_ns and now_ns - cmd.received_ns > self.timeout_ns:
+            if not self.timed_out:
+                self.timed_out = True
+                self.notes.append('torque command timed out: torque is zero until the next '
+                                  'command')
+            return _ZERO, None
+        self.timed_out = False
+        if cmd.world:
+            return _ZERO, cmd.vector
+        return cmd.principal, None
+
+    def take_notes(self):
+        """Return and forget the notes for the log."""
+        with self.lock:
+            notes, self.notes = self.notes, []
+        return notes
+
+    # ------------------------------------------------------------------ stepping
+    def advance(self, now_ns, outbox):
+        """One integration step (call under ``lock``); a publish tick's snapshot goes to outbox."""
+        torque, torque_world = self.torque_now(now_ns)
+        self.stepper.step(torque, torque_world)
+        self.steps += 1
+        if torque_world is not None:
+            q = self.stepper.q
+            torque = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), torque_world)
+        if torque[0] or torque[1] or torque[2]:
+            self._baseline()
+        self.last_torque = torque
+        if self.steps % self.publish_every == 0:
+            outbox.append(self.snapshot())
+
+    def snapshot(self):
+        """Take the current :class:`Snapshot` (call under ``lock``)."""
+        s = self.stepper
+        return Snapshot(self.start_ns + int(self.steps * self.dt_ns), self.steps, s.q, s.omega,
+                        self.last_torque, self.inertia)
+
+    # ------------------------------------------------------------------ diagnostics
+    def health(self):
+        """
+        Numbers for diagnostics, read under the lock.
+
+        Returns a dict: steps, simulated time (s), quaternion norm error,
+        energy / |L| drift (rel.) and L direction drift (rad) since the last
+        torque or change, work since reset (J), the held command (or None),
+        timed_out, paused and a copy of the counters.
+        """
+        with self.lock:
+            s = self.stepper
+            t0, l0 = self.base
+            t1, l1 = self.invariants()
+            g0 = math.sqrt(sum(c * c for c in l0))
+            g1 = math.sqrt(sum(c * c for c in l1))
+            return {
+                'steps': self.steps, 'time': self.steps * self.dt,
+                'quaternion norm error': abs(math.sqrt(sum(c * c for c in s.q)) - 1.0),
+                'energy drift': abs(t1 - t0) / t0 if t0 else 0.0,
+                'momentum drift': abs(g1 - g0) / g0 if g0 else 0.0,
+                'direction drift': math.atan2(float(np.linalg.norm(np.cross(l0, l1))),
+                                              float(np.dot(l0, l1))),
+                'work': s.work, 'command': self.command_held, 'timed_out': self.timed_out,
+                'paused': self.paused, 'counts': dict(self.counts)}

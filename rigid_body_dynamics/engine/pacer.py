@@ -1,0 +1,113 @@
+"""
+Pacing of simulated bodies on the steady clock, without ROS.
+
+A :class:`Pace` keeps one body's schedule: the anchor (a steady time and
+the step count at it), the real-time factor, missed deadlines and lateness.
+:meth:`Pace.due` integrates every step that is due now (or a batch of steps
+as fast as possible when the factor is 0) and returns the wall time until the
+next one; one thread can drive one body or many (attitude_fleet) with it.
+The clock is passed in (``clock()`` -> int ns, ``perf()`` -> s), so tests run
+it on a fake clock.
+"""
+
+import time
+
+_NS = 1_000_000_000
+#: Wall time the pacing may fall behind before the backlog is dropped (s).
+MAX_LAG = 0.25
+#: A step computed more than this after its deadline counts as a missed deadline (s).
+LATE_LIMIT = 0.005
+#: In as-fast-as-possible mode, wall time per batch of steps (s), and the pause
+#: after each batch that lets other threads take the body's lock (services,
+#: parameters, torque commands, diagnostics); without it the lock is re-taken
+#: at once and the executor starves.
+AFAP_BATCH = 0.005
+AFAP_YIELD = 0.0002
+#: Wait (s) while the body is paused.
+PAUSED_WAIT = 0.05
+
+
+class Pace:
+    """
+    The schedule of one :class:`~rigid_body_dynamics.engine.body.BodySimulation`.
+
+    ``rtf``: simulated s per wall s (0 = as fast as possible). ``missed``
+    counts steps computed more than LATE_LIMIT after their deadline,
+    ``max_late_ns`` the worst lateness since :meth:`take_max_late`;
+    ``on_backlog(steps)`` is called when a backlog over MAX_LAG is dropped.
+    """
+
+    def __init__(self, body, rtf, clock=time.monotonic_ns, perf=time.perf_counter,
+                 on_backlog=None):
+        self.body = body
+        self.rtf = float(rtf)
+        self.clock, self.perf = clock, perf
+        self.on_backlog = on_backlog or (lambda steps: None)
+        self.missed = 0
+        self.max_late_ns = 0
+        self.anchor()
+        self._stats = (clock(), body.steps)
+
+    def anchor(self):
+        """Restart the schedule: the next step is due one period from now."""
+        self.anchor_ns = self.clock()
+        self.anchor_steps = self.body.steps
+
+    def restart(self):
+        """After a reset of the body: a new anchor and no lateness counted so far."""
+        self.missed = 0
+        self.max_late_ns = 0
+        self._stats = (self.clock(), self.body.steps)
+        self.anchor()
+
+    def set_rtf(self, rtf):
+        """Change the real-time factor (re-anchors)."""
+        self.rtf = float(rtf)
+        self.anchor()
+
+    def due(self, outbox):
+        """
+        Integrate the body's due steps (its publish ticks' snapshots go to ``outbox``).
+
+        Returns the wall time (s) until the next step is due.
+        """
+        body = self.body
+        with body.lock:
+            if body.paused:
+                return PAUSED_WAIT
+            if self.rtf == 0.0:
+                end = self.perf() + AFAP_BATCH
+                while self.perf() < end:
+                    body.advance(self.clock(), outbox)
+                return AFAP_YIELD
+            now = self.clock()
+            period = body.dt_ns / self.rtf
+            behind = self.anchor_steps + int((now - self.anchor_ns) / period) - body.steps
+            if behind > 0:
+                # lateness of the oldest due step
+                late = now - (self.anchor_ns + (body.steps + 1 - self.anchor_steps) * period)
+                self.max_late_ns = max(self.max_late_ns, late)
+                if late > LATE_LIMIT * _NS:
+                    self.missed += 1
+                if behind * period > MAX_LAG * _NS:
+                    self.on_backlog(behind)
+                    self.anchor()
+                    behind = 1
+                for _ in range(behind):
+                    body.advance(now, outbox)
+            next_due = self.anchor_ns + (body.steps + 1 - self.anchor_steps) * period
+            return max(0.0, (next_due - self.clock()) / _NS)
+
+    def achieved(self):
+        """Return the achieved real-time factor (simulated s per wall s) since the last call."""
+        with self.body.lock:
+            now, steps = self.clock(), self.body.steps
+            then, steps_then = self._stats
+            self._stats = (now, steps)
+            return (steps - steps_then) * self.body.dt_ns / max(now - then, 1)
+
+    def take_max_late(self):
+        """Return the worst lateness (ms) since the previous call and start over."""
+        with self.body.lock:
+            late, self.max_late_ns = self.max_late_ns, 0
+        return late / 1e6

@@ -1,0 +1,104 @@
+"""
+StatePublisher: the state topics of one simulated body, as a helper that takes a node.
+
+Like tf2_ros' ``TransformBroadcaster(node)``: the node keeps its parameters,
+subscriptions and services; this object owns the publishers of ``odom``,
+``orientation``, ``angular_velocity``, ``angular_momentum``,
+``angular_momentum_body``, ``applied_torque``, ``imu`` (optional), the latched
+``inertia`` and ``/clock`` (optional), and turns an engine
+:class:`~rigid_body_dynamics.engine.body.Snapshot` into their messages. All
+messages of one tick carry the snapshot's stamp; vectors are published in the
+user's body frame (``body_frame``) or the world frame (``world_frame``).
+"""
+
+from geometry_msgs.msg import InertiaStamped, QuaternionStamped, Vector3Stamped, WrenchStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos_overriding_options import QoSOverridingOptions
+from rosgraph_msgs.msg import Clock as ClockMsg
+from sensor_msgs.msg import Imu
+
+from . import conversions as conv
+from ..physics import quaternions
+
+STATE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
+                       reliability=ReliabilityPolicy.RELIABLE,
+                       durability=DurabilityPolicy.VOLATILE)
+LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
+                         reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
+                       reliability=ReliabilityPolicy.BEST_EFFORT)
+
+
+class StatePublisher:
+    """The state publishers of one body on ``node``: ``frames`` = (world, body) frame ids."""
+
+    def __init__(self, node, frames, publish_imu=True, publish_clock=False):
+        self.world_frame, self.body_frame = frames
+        qos_opts = QoSOverridingOptions.with_default_policies()
+
+        def pub(msg_type, name, qos=STATE_QOS):
+            return node.create_publisher(msg_type, name, qos, qos_overriding_options=qos_opts)
+        self._odom = pub(Odometry, 'odom')
+        self._orientation = pub(QuaternionStamped, 'orientation')
+        self._omega = pub(Vector3Stamped, 'angular_velocity')
+        self._l_world = pub(Vector3Stamped, 'angular_momentum')
+        self._l_body = pub(Vector3Stamped, 'angular_momentum_body')
+        self._torque = pub(WrenchStamped, 'applied_torque')
+        self._imu = pub(Imu, 'imu') if publish_imu else None
+        self._inertia = pub(InertiaStamped, 'inertia', LATCHED_QOS)
+        self._clock = node.create_publisher(ClockMsg, '/clock', CLOCK_QOS) \
+            if publish_clock else None
+
+    def publish(self, snapshot):
+        """Publish the state topics of one tick from an engine Snapshot (principal frame)."""
+        inertia = snapshot.inertia
+        q_p, w_p = snapshot.q, snapshot.omega
+        stamp = conv.time_msg(snapshot.stamp_ns)
+        world, body_frame = self.world_frame, self.body_frame
+        q_b = inertia.attitude_to_body(np.array(q_p))
+        w_b = inertia.to_body(np.array(w_p))
+        m_p = tuple(i * w for i, w in zip(inertia.moments, w_p))
+        l_world = quaternions.rotate_components(q_p, m_p)
+        l_body = inertia.to_body(np.array(m_p))
+        tau_b = inertia.to_body(np.array(snapshot.torque))
+        q_msg = conv.quaternion_msg(q_b)
+        w_msg = conv.vector_msg(w_b)
+
+        odom = Odometry()
+        odom.header.stamp, odom.header.frame_id, odom.child_frame_id = stamp, world, body_frame
+        odom.pose.pose.orientation = q_msg
+        odom.twist.twist.angular = w_msg
+        self._odom.publish(odom)
+        msg = QuaternionStamped(quaternion=q_msg)
+        msg.header.stamp, msg.header.frame_id = stamp, world
+        self._orientation.publish(msg)
+        for pub, vec, frame in ((self._omega, w_b, body_frame), (self._l_world, l_world, world),
+                                (self._l_body, l_body, body_frame)):
+            msg = Vector3Stamped(vector=conv.vector_msg(vec))
+            msg.header.stamp, msg.header.frame_id = stamp, frame
+            pub.publish(msg)
+        wrench = WrenchStamped()
+        wrench.header.stamp, wrench.header.frame_id = stamp, body_frame
+        wrench.wrench.torque = conv.vector_msg(tau_b)
+        self._torque.publish(wrench)
+        if self._imu is not None:
+            imu = Imu(orientation=q_msg, angular_velocity=w_msg)
+            imu.header.stamp, imu.header.frame_id = stamp, body_frame
+            imu.linear_acceleration_covariance[0] = -1.0
+            self._imu.publish(imu)
+        if self._clock is not None:
+            self._clock.publish(ClockMsg(clock=stamp))
+
+    def publish_inertia(self, inertia, stamp_ns):
+        """Publish the latched inertia tensor (kg m^2, body frame; the mass is not modelled)."""
+        msg = InertiaStamped()
+        msg.header.stamp = conv.time_msg(stamp_ns)
+        msg.header.frame_id = self.body_frame
+        t = inertia.tensor
+        msg.inertia.m = 0.0
+        msg.inertia.ixx, msg.inertia.ixy, msg.inertia.ixz = t[0, 0], t[0, 1], t[0, 2]
+        msg.inertia.iyy, msg.inertia.iyz, msg.inertia.izz = t[1, 1], t[1, 2], t[2, 2]
+        self._inertia.publish(msg)

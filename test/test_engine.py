@@ -1,0 +1,182 @@
+"""The ROS-free engine: one body's rules and its pacing, on a fake steady clock (no rclpy)."""
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from rigid_body_dynamics.engine import BodySimulation, Pace
+from rigid_body_dynamics.engine import pacer
+from rigid_body_dynamics.physics import FreeRigidBody, Inertia, make_integrator, quaternions
+
+MS = 1_000_000
+
+
+class FakeClock:
+    """A steady clock the test moves by hand: ``clock()`` int ns, ``perf()`` s."""
+
+    def __init__(self):
+        self.ns = 10 ** 12
+
+    def __call__(self):
+        return self.ns
+
+    def perf(self):
+        return self.ns / 1e9
+
+    def advance(self, ns):
+        self.ns += int(ns)
+
+
+def make_body(**kwargs):
+    options = {'inertia': Inertia((1.0, 2.0, 3.0)), 'integrator': 'exact', 'rate': 1000.0,
+               'initial': ((0.0, 0.0, 0.0, 1.0), (0.3, 1.5, -0.4)), 'torque_timeout': 0.5,
+               'max_torque': 0.0, 'publish_every': 10, 'start_ns': 0}
+    options.update(kwargs)
+    return BodySimulation(**options)
+
+
+def test_the_engine_imports_no_ros():
+    code = ('import sys, rigid_body_dynamics.engine; print(sorted(m for m in sys.modules '
+            'if m.split(".")[0] in ("rclpy", "rosidl_runtime_py")))')
+    out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.strip() == '[]', out.stdout + out.stderr
+
+
+def test_held_torque_matches_the_integrator_and_snapshots_carry_stamps():
+    body, outbox = make_body(), []
+    body.command((0.1, -0.2, 0.05), False, now_ns=0)
+    with body.lock:
+        for _ in range(100):
+            body.advance(now_ns=50 * MS, outbox=outbox)
+    ref = make_integrator('exact', (1.0, 2.0, 3.0), 1e-3, (0.0, 0.0, 0.0, 1.0), (0.3, 1.5, -0.4))
+    for _ in range(100):
+        ref.step((0.1, -0.2, 0.05))
+    assert body.stepper.q == ref.q and body.stepper.omega == ref.omega
+    assert [s.stamp_ns for s in outbox] == [k * 10 * MS for k in range(1, 11)]
+    assert outbox[-1].torque == (0.1, -0.2, 0.05) and outbox[-1].steps == 100
+
+
+def test_watchdog_times_out_the_command_once_and_says_so():
+    body, outbox = make_body(torque_timeout=0.5), []
+    body.command((0.0, 0.0, 1.0), False, now_ns=0)
+    with body.lock:
+        body.advance(499 * MS, outbox)
+        assert body.last_torque == (0.0, 0.0, 1.0)
+        body.advance(501 * MS, outbox)
+        body.advance(600 * MS, outbox)
+    assert body.last_torque == (0.0, 0.0, 0.0) and body.timed_out
+    assert body.take_notes() == ['torque command timed out: torque is zero until the next '
+                                 'command']
+    assert body.take_notes() == []
+    body.command((0.0, 0.0, 1.0), False, now_ns=700 * MS)
+    with body.lock:
+        body.advance(701 * MS, outbox)
+    assert body.last_torque == (0.0, 0.0, 1.0) and not body.timed_out
+
+
+def test_clipping_rejection_and_forces_are_counted_and_leave_the_state():
+    body = make_body(max_torque=0.2)
+    before = (body.stepper.q, body.stepper.omega)
+    assert body.command((math.nan, 0.0, 0.0), False, 0) == ['rejected_non_finite']
+    assert body.command_held is None and (body.stepper.q, body.stepper.omega) == before
+    assert body.command((0.5, -0.1, -3.0), False, 0, force=(1.0, 0.0, 0.0)) == [
+        'clipped', 'force_ignored', 'accepted']
+    assert body.command_held.vector == (0.2, -0.1, -0.2)
+    body.reject('rejected_frame')
+    assert body.health()['counts'] == {'accepted': 1, 'rejected_non_finite': 1,
+                                       'rejected_frame': 1, 'clipped': 1, 'force_ignored': 1}
+
+
+def test_world_command_stays_fixed_in_the_world():
+    body, outbox = make_body(), []
+    tau_w = (0.05, -0.02, 0.04)
+    body.command(tau_w, True, 0)
+    l0 = np.array(body.stepper.angular_momentum_world)
+    with body.lock:
+        for _ in range(1000):
+            body.advance(1 * MS, outbox)
+    l1 = np.array(body.stepper.angular_momentum_world)
+    np.testing.assert_allclose(l1 - l0, np.array(tau_w) * 1.0, atol=1e-13)
+    # applied torque reported in the body frame: R^T tau_w at the step's end
+    q = body.stepper.q
+    np.testing.assert_allclose(outbox[-1].torque, quaternions.rotate_inverse(q, tau_w),
+                               atol=1e-15)
+
+
+def test_reset_pause_and_a_rotated_inertia_change():
+    body, outbox = make_body(), []
+    body.command((0.0, 0.3, 0.0), False, 0)
+    with body.lock:
+        for _ in range(20):
+            body.advance(1 * MS, outbox)
+    q_b, w_b = body.body_state()
+    rotated = Inertia.from_tensor([1.5, 2.0, 2.5, 0.2, 0.0, 0.1])
+    lines = body.configure(inertia=rotated)
+    assert lines and 'attitude and angular velocity kept' in lines[0]
+    q_b2, w_b2 = body.body_state()
+    np.testing.assert_allclose(w_b2, w_b, atol=1e-15)
+    assert float(quaternions.angle_between(q_b, q_b2)) < 1e-15
+    assert body.command_held.principal != (0.0, 0.3, 0.0)      # re-expressed in the new frame
+    assert body.set_paused(True) is False and body.paused
+    body.reset()
+    assert body.steps == 0 and not body.paused and body.command_held is None
+    assert body.snapshot().stamp_ns == 0
+
+
+def test_drift_since_the_last_torque():
+    body, outbox = make_body(), []
+    body.command((0.0, 0.3, 0.0), False, 0)
+    with body.lock:
+        body.advance(1 * MS, outbox)
+    body.command((0.0, 0.0, 0.0), False, 2 * MS)
+    with body.lock:
+        for _ in range(2000):
+            body.advance(3 * MS, outbox)
+    h = body.health()
+    assert h['energy drift'] < 1e-14 and h['momentum drift'] < 1e-14
+    assert h['direction drift'] < 1e-14 and h['work'] != 0.0
+
+
+def test_pace_real_time_steps_lateness_and_backlog():
+    clock = FakeClock()
+    body = make_body()
+    backlog = []
+    pace = Pace(body, 1.0, clock=clock, perf=clock.perf, on_backlog=backlog.append)
+    outbox = []
+    assert pace.due(outbox) == pytest.approx(1e-3)              # nothing due yet
+    clock.advance(10 * MS)
+    wait = pace.due(outbox)
+    assert body.steps == 10 and len(outbox) == 1 and wait == pytest.approx(1e-3)
+    assert pace.missed == 1                                       # the oldest was 9 ms late
+    clock.advance(int(0.3e9))                                     # 300 ms behind: dropped
+    pace.due(outbox)
+    assert backlog == [300] and body.steps == 11
+    pace.set_rtf(2.0)
+    clock.advance(10 * MS)
+    pace.due(outbox)
+    assert body.steps == 31                                        # 2x: 20 steps in 10 ms
+    assert pace.achieved() > 0.0 and pace.take_max_late() > 0.0
+
+
+def test_pace_as_fast_as_possible_and_paused():
+    clock = FakeClock()
+    body = make_body()
+    ticks = iter(range(10 ** 9))
+
+    def perf():               # each look at the clock moves it 0.5 ms: a 5 ms batch = 10 steps
+        return next(ticks) * 0.0005
+    pace = Pace(body, 0.0, clock=clock, perf=perf)
+    assert pace.due([]) == pacer.AFAP_YIELD and body.steps == 9
+    body.set_paused(True)
+    assert pace.due([]) == pacer.PAUSED_WAIT and body.steps == 9
+
+
+def test_torque_free_steps_stay_exact():
+    body, outbox = make_body(publish_every=1000), []
+    with body.lock:
+        for _ in range(5000):
+            body.advance(0, outbox)
+    q, w = FreeRigidBody((1.0, 2.0, 3.0), (0.3, 1.5, -0.4)).state_at(5.0)
+    assert float(quaternions.angle_between(outbox[-1].q, q)) < 1e-13
