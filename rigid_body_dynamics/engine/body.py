@@ -173,7 +173,7 @@ class BodySimulation:
 
     def command(self, vector, world, now_ns, force=_ZERO):
         """
-        Take a torque command (N m, in the body or, if ``world``, the world frame) and hold it.
+        Hold a new torque: N m in the body frame, or in the world frame if ``world``.
 
         A non-finite torque is refused and counted (returns 'rejected_non_finite',
         the state untouched); a component beyond ``max_torque`` is clipped and
