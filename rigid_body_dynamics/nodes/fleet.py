@@ -35,6 +35,7 @@ import sys
 import threading
 import time
 
+import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.utilities import remove_ros_args
 
@@ -68,14 +69,14 @@ class Fleet:
     """The bodies of one process and the thread that steps them (``shared``) or theirs."""
 
     def __init__(self, names, shared=True, **kwargs):
+        self._logger = rclpy.logging.get_logger('attitude_fleet')
         self.nodes = []
         self.shared = shared
         self._stop = threading.Event()
         self._thread = None
         try:
             for name in names:
-                self.nodes.append(AttitudeSimulator(namespace='/' + name,
-                                                    diagnostics_timer=False, **kwargs))
+                self.nodes.append(AttitudeSimulator(namespace='/' + name, **kwargs))
             clocks = [n.get_namespace() for n in self.nodes if n.get_parameter(
                 'publish_clock').value]
             if len(clocks) > 1:
@@ -87,6 +88,7 @@ class Fleet:
             for node in self.nodes:
                 node.destroy_node()
             raise
+        self.context = self.nodes[0].context     # one context, shared by every body
         # Each executor wake-up rebuilds the wait set of every body (about 0.3 ms
         # per body, holding the GIL), so the bodies have no diagnostics timers of
         # their own: the shared thread publishes their diagnostics within its
@@ -94,7 +96,7 @@ class Fleet:
         if not shared:
             self.nodes[0].create_timer(DIAGNOSTIC_PERIOD, self._publish_diagnostics,
                                        clock=Clock(clock_type=ClockType.STEADY_TIME))
-        self.nodes[0].get_logger().info(
+        self._logger.info(
             f'{len(self.nodes)} bodies in this process ({", ".join(names[:5])}'
             f'{", ..." if len(names) > 5 else ""}), '
             f'{"one shared integration thread" if shared else "one integration thread each"}')
@@ -107,15 +109,16 @@ class Fleet:
         """Start stepping the bodies; with a thread each, every body sets the GIL interval."""
         if not self.shared:
             for node in self.nodes:
-                node.start()
+                node.start(diagnostics=False)
             return
         sys.setswitchinterval(SWITCH_INTERVAL)
         self._pending = collections.deque()   # (node, snapshot or None = diagnostics)
         self._outbox = []
         self._next_diagnostics = time.monotonic() + DIAGNOSTIC_PERIOD
-        self._thread = threading.Thread(target=integration_loop, name='fleet integration',
-                                        args=(self._cycle, self._stop, self.nodes[0]),
-                                        daemon=True)
+        priority = max(node.thread_priority for node in self.nodes)
+        self._thread = threading.Thread(
+            target=integration_loop, name='fleet integration', daemon=True,
+            args=(self._cycle, self._stop, priority, self._logger, self.context))
         self._thread.start()
 
     def stop(self):
@@ -136,7 +139,8 @@ class Fleet:
         wait = math.inf
         outbox = self._outbox
         for node in self.nodes:
-            wait = min(wait, node.step_due(outbox))
+            wait = min(wait, node.pace.due(outbox))
+            node.log_notes()
             if outbox:
                 pending.extend((node, snapshot) for snapshot in outbox)
                 outbox.clear()
@@ -148,7 +152,7 @@ class Fleet:
             if snapshot is None:
                 node.publish_diagnostics()
             else:
-                node.publish_state(snapshot)
+                node.state.publish(snapshot)
         if not pending and wait > 0.0:
             self._stop.wait(min(wait, self._next_diagnostics - time.monotonic(), 0.05))
 

@@ -74,21 +74,21 @@ def use_thread_priority(priority, logger):
     logger.info(f'integration thread runs under SCHED_FIFO at priority {priority}')
 
 
-def integration_loop(cycle, stop, node):
+def integration_loop(cycle, stop, priority, logger, context):
     """
     Call ``cycle()`` until the event ``stop`` is set: the body of an integration thread.
 
-    Applies ``node``'s thread_priority first. An error after shutdown began
-    (a publisher closed under the loop) ends it quietly; any other is logged
-    on ``node`` and raised.
+    Applies the SCHED_FIFO ``priority`` first (0: none). An error after
+    shutdown began (a publisher closed under the loop) ends it quietly; any
+    other is logged on ``logger`` and raised.
     """
-    use_thread_priority(node.thread_priority, node.get_logger())
+    use_thread_priority(priority, logger)
     try:
         while not stop.is_set():
             cycle()
     except Exception as err:
-        if rclpy.ok(context=node.context) and not stop.is_set():
-            node.get_logger().error(f'integration thread stopped: {err!r}')
+        if rclpy.ok(context=context) and not stop.is_set():
+            logger.error(f'integration thread stopped: {err!r}')
             raise
 
 
@@ -96,11 +96,12 @@ class AttitudeSimulator(Node):
     """
     The attitude_simulator node. ``kwargs`` go to rclpy's Node (context, overrides).
 
-    ``diagnostics_timer=False`` leaves the 1 Hz diagnostics to the caller
-    (``publish_diagnostics``), as attitude_fleet does with one timer for all.
+    :meth:`start` starts its integration thread and diagnostics timer. A host
+    of many bodies (attitude_fleet) instead drives ``pace`` itself, publishes
+    the snapshots with ``state`` and calls :meth:`publish_diagnostics`.
     """
 
-    def __init__(self, diagnostics_timer=True, **kwargs):
+    def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
         self._stop = threading.Event()
         self._thread = None
@@ -122,7 +123,7 @@ class AttitudeSimulator(Node):
             self._publish_every(values['publish_rate']), start_ns)
         self._publish_rate = values['publish_rate']
         self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog)
-        self._make_interfaces(diagnostics_timer)
+        self._make_interfaces()
         self.state.publish_inertia(self.body.inertia, start_ns)
         self.state.publish(self.body.snapshot())
         self.add_on_set_parameters_callback(self._on_set_parameters)
@@ -275,7 +276,7 @@ class AttitudeSimulator(Node):
             self.get_logger().info(line)
 
     # ------------------------------------------------------------------ interfaces
-    def _make_interfaces(self, diagnostics_timer):
+    def _make_interfaces(self):
         self.state = StatePublisher(self, self._frames,
                                     publish_imu=self.get_parameter('publish_imu').value,
                                     publish_clock=self._publish_clock)
@@ -286,9 +287,6 @@ class AttitudeSimulator(Node):
             qos_overriding_options=QoSOverridingOptions.with_default_policies())
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
-        if diagnostics_timer:   # else someone calls publish_diagnostics (attitude_fleet)
-            steady = Clock(clock_type=ClockType.STEADY_TIME)
-            self.create_timer(DIAGNOSTIC_PERIOD, self.publish_diagnostics, clock=steady)
 
     # ------------------------------------------------------------------ torque
     def _on_torque(self, msg):
@@ -317,11 +315,21 @@ class AttitudeSimulator(Node):
                  'does not translate)', period=math.inf)
 
     # ------------------------------------------------------------------ stepping
-    def start(self):
-        """Start the integration thread (and shorten the GIL switch interval, process-wide)."""
+    def start(self, diagnostics=True):
+        """
+        Start the integration thread (and shorten the GIL switch interval, process-wide).
+
+        With ``diagnostics`` also the 1 Hz diagnostics timer (steady clock);
+        attitude_fleet with a thread per body serves all bodies from one timer.
+        """
+        if diagnostics:
+            steady = Clock(clock_type=ClockType.STEADY_TIME)
+            self.create_timer(DIAGNOSTIC_PERIOD, self.publish_diagnostics, clock=steady)
         sys.setswitchinterval(SWITCH_INTERVAL)
-        self._thread = threading.Thread(target=integration_loop, name='integration',
-                                        args=(self._cycle, self._stop, self), daemon=True)
+        self._thread = threading.Thread(
+            target=integration_loop, name='integration', daemon=True,
+            args=(self._cycle, self._stop, self.thread_priority, self.get_logger(),
+                  self.context))
         self._thread.start()
 
     def stop(self):
@@ -336,30 +344,24 @@ class AttitudeSimulator(Node):
         if wait > 0.0:
             self._stop.wait(wait)
 
-    def step_due(self, outbox=None):
+    def step_due(self):
         """
-        Integrate the steps that are due now (a batch, as fast as possible) and publish.
+        Integrate the steps that are due now (a batch, as fast as possible) and publish them.
 
-        Returns the wall time (s) until the next step is due. Called by this
-        node's integration thread, or by one thread that steps many bodies
-        (attitude_fleet) instead of ``start()``; given a list ``outbox``, the
-        snapshots of the publish ticks go there (for ``publish_state``)
-        instead of being published at once.
+        Returns the wall time (s) until the next step is due. Publishing happens
+        outside the body's lock: a torque command never waits for it.
         """
-        publish_now = outbox is None
-        outbox = [] if publish_now else outbox
+        outbox = []
         wait = self.pace.due(outbox)
-        for note in self.body.take_notes():
-            self.get_logger().info(note)
-        # publish outside the lock: a torque command never waits for publishing
-        if publish_now:
-            for snapshot in outbox:
-                self.state.publish(snapshot)
+        self.log_notes()
+        for snapshot in outbox:
+            self.state.publish(snapshot)
         return wait
 
-    def publish_state(self, snapshot):
-        """Publish the state topics of one publish tick (a snapshot taken under the lock)."""
-        self.state.publish(snapshot)
+    def log_notes(self):
+        """Log what the body noted while stepping (the watchdog's timeouts)."""
+        for note in self.body.take_notes():
+            self.get_logger().info(note)
 
     def _on_backlog(self, behind):
         self._warnings.warn('backlog', f'cannot keep up with real_time_factor {self.pace.rtf:g}: '
