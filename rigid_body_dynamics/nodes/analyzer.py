@@ -33,7 +33,7 @@ from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
 from . import conversions as conv, diagnostics
-from .parameters import as_float, as_vector, check_change, ConfigurationError, descriptor
+from .parameters import as_vector, ConfigurationError, Param, ParameterTable
 from .runner import run
 from .throttle import ThrottledWarnings
 from .. import samples
@@ -55,6 +55,54 @@ _ALWAYS, _NEVER = -2 ** 63, 2 ** 63 - 1
 
 OK, WARN, ERROR, STALE = (DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR,
                           DiagnosticStatus.STALE)
+
+
+def _inertia(raw):
+    """Convert the inertia parameter: 3 principal moments or 6 tensor elements (kg m^2)."""
+    try:
+        size = len(raw)
+        if size == 3:
+            return Inertia(as_vector('inertia', raw, 3))
+        return Inertia.from_tensor(as_vector('inertia', raw, 6))
+    except (TypeError, ValueError) as err:
+        raise ConfigurationError(f'inertia: {err}') from None
+
+
+#: The parameters of attitude_analyzer (README's list is made from this; test_config checks).
+PARAMETERS = ParameterTable([
+    Param('inertia', 'double[3|6]', None, 'unset',
+          'Principal moments [I1, I2, I3] (kg m^2) of the body in its odom child frame, or 6 '
+          'tensor elements [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]; unset = from the latched inertia '
+          'topic.', convert=_inertia),
+    Param('window', 'double', 10.0, '10.0 s', 'Length of the analysed history (s of stamps).',
+          low=0.1, high=1e9),
+    Param('energy_tolerance', 'double', 1e-6, '1e-6',
+          'Relative drift of T in free motion above which conservation is WARN; 100x that is '
+          'ERROR.', low=0.0, high=1.0),
+    Param('momentum_tolerance', 'double', 1e-6, '1e-6',
+          'Relative drift of |L| and of the L direction (rad) in free motion above which '
+          'conservation is WARN; 100x that is ERROR.', low=0.0, high=1.0),
+    Param('balance_tolerance', 'double', 1e-2, '1e-2',
+          'Under torque: relative work-energy and impulse-momentum residual above which '
+          'conservation is WARN (100x: ERROR). Sampled torque costs an O(dt) quadrature error '
+          'at each torque change, so this is looser than the free-motion tolerances.',
+          low=0.0, high=1.0),
+    Param('rate_tolerance', 'double', 1e-6, '1e-6',
+          'Relative difference between a measured rate or period of the free motion and '
+          'theory above which precession is WARN; 100x that is ERROR.', low=0.0, high=1.0),
+    Param('stale_timeout', 'double', 1.0, '1.0 s',
+          'Input is STALE when no odom arrived for this long (s, steady clock).',
+          low=0.0, high=1e6),
+    Param('reset_jump', 'double', 0.5, '0.5 s',
+          'A stamp this much (s) before the newest is a reset: estimates restart.',
+          low=0.0, high=1e9),
+    Param('max_gap', 'double', 1.0, '1.0 s',
+          'A gap between stamps longer than this (s) restarts the estimates.',
+          low=0.0, high=1e9),
+    Param('diagnostic_period', 'double', 1.0, '1.0 s',
+          'Period of the analysis and of /diagnostics (s, steady clock).', low=0.01,
+          high=3600.0, read_only=True),
+])
 
 
 class SampleBuffer:
@@ -127,42 +175,7 @@ class AttitudeAnalyzer(Node):
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
         self._warnings = ThrottledWarnings(self.get_logger(), period=5.0)
-        num = {'dynamic_typing': True}
-        self.declare_parameter('inertia', None, descriptor(
-            'Principal moments [I1, I2, I3] (kg m^2) of the body in its odom child frame, or '
-            '6 tensor elements [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]; unset = from the latched '
-            'inertia topic.', **num))
-        self.declare_parameter('window', 10.0, descriptor(
-            'Length of the analysed history (s of stamps).', low=0.1, high=1e9, **num))
-        self.declare_parameter('energy_tolerance', 1e-6, descriptor(
-            'Relative drift of T (or work-energy residual under torque) above which '
-            'conservation is WARN; 100x that is ERROR.', low=0.0, high=1.0, **num))
-        self.declare_parameter('momentum_tolerance', 1e-6, descriptor(
-            'Relative drift of |L| and L direction (rad), or impulse-momentum residual under '
-            'torque, above which conservation is WARN; 100x that is ERROR.',
-            low=0.0, high=1.0, **num))
-        self.declare_parameter('balance_tolerance', 1e-2, descriptor(
-            'Under torque: relative work-energy and impulse-momentum residual above which '
-            'conservation is WARN (100x: ERROR). Sampled torque costs an O(dt) quadrature '
-            'error at each torque change, so this is looser than the free-motion tolerances.',
-            low=0.0, high=1.0, **num))
-        self.declare_parameter('rate_tolerance', 1e-6, descriptor(
-            'Relative difference between a measured rate or period of the free motion and '
-            'theory above which precession is WARN; 100x that is ERROR.',
-            low=0.0, high=1.0, **num))
-        self.declare_parameter('stale_timeout', 1.0, descriptor(
-            'Input is STALE when no odom arrived for this long (s, steady clock).',
-            low=0.0, high=1e6, **num))
-        self.declare_parameter('reset_jump', 0.5, descriptor(
-            'A stamp this much (s) before the newest is a reset: estimates restart.',
-            low=0.0, high=1e9, **num))
-        self.declare_parameter('max_gap', 1.0, descriptor(
-            'A gap between stamps longer than this (s) restarts the estimates.',
-            low=0.0, high=1e9, **num))
-        self.declare_parameter('diagnostic_period', 1.0, descriptor(
-            'Period of the analysis and of /diagnostics (s, steady clock).', read_only=True,
-            low=0.01, high=3600.0, **num))
-        self._settings = self._validate({p.name: p.value for p in self._parameters.values()})
+        self._settings = PARAMETERS.validate(PARAMETERS.declare(self))
         self._inertia_source = 'parameter' if self._settings['inertia'] else None
         self._inertia = self._settings['inertia']
         self._buffer = SampleBuffer()
@@ -192,34 +205,12 @@ class AttitudeAnalyzer(Node):
                                 if self._inertia else '; waiting for the inertia topic'))
 
     # ---------------------------------------------------------------- parameters
-    def _validate(self, values):
-        out = dict(values)
-        raw = values.get('inertia')
-        try:
-            if raw is None or (hasattr(raw, '__len__') and len(raw) == 0):
-                out['inertia'] = None
-            elif len(raw) == 3:
-                out['inertia'] = Inertia(as_vector('inertia', raw, 3))
-            else:
-                out['inertia'] = Inertia.from_tensor(as_vector('inertia', raw, 6))
-        except (TypeError, ValueError) as err:
-            raise ConfigurationError(f'inertia: {err}') from None
-        for name, low, high in (('window', 0.1, 1e9), ('energy_tolerance', 0.0, 1.0),
-                                ('balance_tolerance', 0.0, 1.0), ('rate_tolerance', 0.0, 1.0),
-                                ('momentum_tolerance', 0.0, 1.0), ('stale_timeout', 0.0, 1e6),
-                                ('reset_jump', 0.0, 1e9), ('max_gap', 0.0, 1e9),
-                                ('diagnostic_period', 0.01, 3600.0)):
-            out[name] = as_float(name, values[name], low, high)
-        return out
-
     def _on_set_parameters(self, params):
         """Validate only (no side effects); the post-set callback applies."""
-        values = {p.name: p.value for p in self._parameters.values()}
-        values.update({p.name: p.value for p in params})
-        return check_change(self.get_logger(), self._validate, values)
+        return PARAMETERS.on_set(self, params)
 
     def _post_set_parameters(self, params):
-        settings = self._validate({p.name: p.value for p in self._parameters.values()})
+        settings = PARAMETERS.validate(PARAMETERS.values(self))
         if 'inertia' in {p.name for p in params} and settings['inertia'] is not None:
             self._inertia, self._inertia_source = settings['inertia'], 'parameter'
             self._restart('inertia changed')

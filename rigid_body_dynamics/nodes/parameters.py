@@ -7,7 +7,9 @@ integer array) is accepted and converted, instead of failing on
 then checked here, with a reason for every refusal.
 """
 
+from dataclasses import dataclass
 import math
+import textwrap
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rcl_interfaces.msg import SetParametersResult
@@ -73,3 +75,116 @@ def check_change(logger, validate, values):
         logger.warn(f'parameter change refused: {err}')
         return SetParametersResult(successful=False, reason=str(err))
     return SetParametersResult(successful=True)
+
+
+@dataclass(frozen=True)
+class Param:
+    """
+    One node parameter: declaration, validation and its README line from one place.
+
+    ``kind``: 'double', 'double[N]', 'double[3|6]', 'int', 'bool' or 'string'.
+    ``default``: the value, or a callable of the node returning it (it may
+    read parameters declared before it, e.g. the preset); None for an
+    optional parameter that is unset.
+    ``shown``: the default as the README shows it (e.g. '1000.0 Hz', 'preset').
+    ``text``: what it means, with units; the descriptor's description and the
+    README's text. ``low`` / ``high``: the inclusive range (rclpy enforces it
+    for numbers); ``choices``: allowed strings; ``convert(value)``: a custom
+    check returning the converted value (ConfigurationError with the reason).
+    """
+
+    name: str
+    kind: str
+    default: object
+    shown: str
+    text: str
+    low: object = None
+    high: object = None
+    read_only: bool = False
+    choices: tuple = ()
+    convert: object = None
+
+    def descriptor(self):
+        """Build the ParameterDescriptor of this parameter."""
+        numeric = self.kind.startswith('double') or self.kind == 'int'
+        constraints = f'one of: {", ".join(self.choices)}' if self.choices else ''
+        return descriptor(self.text, read_only=self.read_only, low=self.low, high=self.high,
+                          constraints=constraints, integer=self.kind == 'int',
+                          dynamic_typing=numeric)
+
+    def check(self, value):
+        """Return the value converted, or raise ConfigurationError saying why."""
+        if self.default is None and (value is None or (hasattr(value, '__len__')
+                                                       and len(value) == 0)):
+            return None
+        if self.convert is not None:
+            return self.convert(value)
+        if self.kind == 'double':
+            low = -math.inf if self.low is None else self.low
+            high = math.inf if self.high is None else self.high
+            return as_float(self.name, value, low, high)
+        if self.kind.startswith('double['):
+            return as_vector(self.name, value, int(self.kind[7:-1]))
+        if self.kind == 'int':
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise ConfigurationError(f'{self.name} must be an integer, got {value!r}')
+            return value
+        if self.kind == 'bool':
+            return bool(value)
+        if self.choices and value not in self.choices:
+            raise ConfigurationError(f'{self.name} must be one of {", ".join(self.choices)}, '
+                                     f'got {value!r}')
+        return value
+
+    def readme(self):
+        """Return the README line of this parameter (wrapped at 79 columns)."""
+        extras = [self.kind, self.shown]
+        if self.read_only:
+            extras.append('read-only')
+        if self.low is not None and self.high is not None and self.kind in ('double', 'int'):
+            extras.append(f'{self.low:g} .. {self.high:g}')
+        line = f'- `{self.name}` ({", ".join(extras)}) — {self.text}'
+        return textwrap.fill(line, width=79, subsequent_indent='  ', break_on_hyphens=False)
+
+
+class ParameterTable:
+    """
+    The parameters of one node: declare them all, validate a set of values, document them.
+
+    ``cross_checks``: functions ``check(values, out)`` run after every value
+    is converted (``out``), for rules between parameters; they may add
+    derived entries to ``out`` and raise ConfigurationError.
+    """
+
+    def __init__(self, params, cross_checks=()):
+        self.params = {p.name: p for p in params}
+        self.cross_checks = tuple(cross_checks)
+
+    def declare(self, node):
+        """Declare every parameter on ``node`` in order; return their values."""
+        for p in self.params.values():
+            default = p.default(node) if callable(p.default) else p.default
+            node.declare_parameter(p.name, default, p.descriptor())
+        return self.values(node)
+
+    def values(self, node):
+        """Return the current raw values of the table's parameters on ``node``."""
+        return {name: node.get_parameter(name).value for name in self.params}
+
+    def validate(self, values):
+        """Convert and check ``values`` (name -> raw value); ConfigurationError says why."""
+        out = {name: self.params[name].check(value) for name, value in values.items()
+               if name in self.params}
+        for check in self.cross_checks:
+            check(values, out)
+        return out
+
+    def on_set(self, node, params):
+        """Validate a change for an on-set-parameters callback (no side effects)."""
+        values = self.values(node)
+        values.update({p.name: p.value for p in params if p.name in self.params})
+        return check_change(node.get_logger(), self.validate, values)
+
+    def readme(self):
+        """Return the README's parameter list, one entry per parameter, in declaration order."""
+        return '\n'.join(p.readme() for p in self.params.values())

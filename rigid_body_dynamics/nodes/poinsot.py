@@ -24,7 +24,7 @@ from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
 from . import conversions as conv
-from .parameters import as_float, check_change, ConfigurationError, descriptor
+from .parameters import ConfigurationError, Param, ParameterTable
 from .runner import run
 from ..physics import Inertia, poinsot, quaternions
 
@@ -44,42 +44,43 @@ def _point(v):
     return Point(x=float(v[0]), y=float(v[1]), z=float(v[2]))
 
 
+def _trace_length(value):
+    if isinstance(value, bool) or not isinstance(value, int) or value < 2:
+        raise ConfigurationError(f'trace_length must be an integer >= 2, got {value!r}')
+    return value
+
+
+#: The parameters of poinsot_visualizer (README's list is made from this; test_config checks).
+PARAMETERS = ParameterTable([
+    Param('scale', 'double', 1.0, '1.0 m per rad/s',
+          'Marker length per rad/s of angular velocity (m per rad/s).', low=1e-12, high=1e12),
+    Param('trace_length', 'int', 2000, '2000',
+          'Points kept in the polhode and herpolhode traces (at least 2).', read_only=True,
+          convert=_trace_length),
+    Param('marker_rate', 'double', 20.0, '20.0 Hz',
+          'Marker arrays per second of odom stamps (Hz).', low=1e-6, high=1e4),
+])
+
+
 class PoinsotVisualizer(Node):
     """The poinsot_visualizer node; ``kwargs`` go to rclpy's Node."""
 
     def __init__(self, **kwargs):
         super().__init__(NODE_NAME, **kwargs)
-        num = {'dynamic_typing': True}
-        self.declare_parameter('scale', 1.0, descriptor(
-            'Marker length per rad/s of angular velocity (m per rad/s).', low=1e-12, high=1e12,
-            **num))
-        self.declare_parameter('trace_length', 2000, descriptor(
-            'Points kept in the polhode and herpolhode traces.', read_only=True))
-        self.declare_parameter('marker_rate', 20.0, descriptor(
-            'Marker arrays per second of odom stamps (Hz).', low=1e-6, high=1e4, **num))
-        self._scale = as_float('scale', self.get_parameter('scale').value, 1e-12, 1e12)
-        self._period = 1.0 / as_float('marker_rate', self.get_parameter('marker_rate').value,
-                                      1e-6, 1e4)
-        length = self.get_parameter('trace_length').value
-        if not isinstance(length, int) or length < 2:
-            raise ConfigurationError(f'trace_length must be an integer >= 2, got {length!r}')
+        values = PARAMETERS.validate(PARAMETERS.declare(self))
+        self._scale = values['scale']
+        self._period = 1.0 / values['marker_rate']
+        length = values['trace_length']
         self._polhode = deque(maxlen=length)      # body-frame omega (principal axes)
         self._herpolhode = deque(maxlen=length)   # world-frame omega
         self._inertia = None
         self._last = None
-        self.add_on_set_parameters_callback(lambda params: check_change(
-            self.get_logger(), self._check, {p.name: p.value for p in params}))
+        self.add_on_set_parameters_callback(lambda params: PARAMETERS.on_set(self, params))
         self.add_post_set_parameters_callback(self._apply)
         self.create_subscription(InertiaStamped, 'inertia', self._on_inertia, LATCHED_QOS)
         self.create_subscription(Odometry, 'odom', self._on_odom, INPUT_QOS)
         self._pub = self.create_publisher(MarkerArray, 'poinsot_markers', 10)
         self.get_logger().info('waiting for the inertia topic and odom')
-
-    def _check(self, values):
-        if 'scale' in values:
-            as_float('scale', values['scale'], 1e-12, 1e12)
-        if 'marker_rate' in values:
-            as_float('marker_rate', values['marker_rate'], 1e-6, 1e4)
 
     def _apply(self, params):
         for p in params:

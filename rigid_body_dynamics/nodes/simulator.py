@@ -36,7 +36,7 @@ from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
 from . import conversions as conv
-from .parameters import as_float, as_vector, check_change, ConfigurationError, descriptor
+from .parameters import as_vector, ConfigurationError, Param, ParameterTable
 from .runner import run
 from .state_publisher import STATE_QOS, StatePublisher
 from .throttle import ThrottledWarnings
@@ -92,6 +92,114 @@ def integration_loop(cycle, stop, priority, logger, context):
             raise
 
 
+def _preset(node):
+    """Return the preset the other parameters default to (ConfigurationError if unknown)."""
+    try:
+        return presets.get(node.get_parameter('preset').value)
+    except ValueError as err:
+        raise ConfigurationError(str(err)) from None
+
+
+def _integrator(name):
+    if name not in INTEGRATORS:
+        raise ConfigurationError(REMOVED_INTEGRATORS.get(name) or (
+            f'unknown integrator {name!r}; choose one of {", ".join(sorted(INTEGRATORS))}'))
+    return name
+
+
+def _orientation(value):
+    q = as_vector('initial_orientation', value, 4)
+    norm = math.sqrt(sum(c * c for c in q))
+    if norm < 1e-9:
+        raise ConfigurationError('initial_orientation must not be the zero quaternion')
+    return tuple(c / norm for c in q)
+
+
+def _body(values, out):
+    """Cross-check: the Inertia from inertia_tensor (if set) or inertia, as out['body']."""
+    try:
+        if out.get('inertia_tensor') is not None:
+            out['body'] = Inertia.from_tensor(out['inertia_tensor'])
+        else:
+            out['body'] = Inertia(out['inertia'])
+    except ValueError as err:
+        raise ConfigurationError(str(err)) from None
+
+
+def _publish_rate(values, out):
+    """Cross-check: publish_rate <= integration_rate."""
+    if out['publish_rate'] > out['integration_rate']:
+        raise ConfigurationError(f'publish_rate must be within [1e-06, '
+                                 f'{out["integration_rate"]:g}] (at most integration_rate), '
+                                 f'got {out["publish_rate"]:g}')
+
+
+#: The parameters of attitude_simulator (README's list is made from this; test_config checks).
+PARAMETERS = ParameterTable([
+    Param('preset', 'string', presets.DEFAULT, f'`{presets.DEFAULT}`',
+          'Named body from physics/presets.py; its values are the defaults of the parameters '
+          'below, which override them.', read_only=True, choices=tuple(sorted(presets.PRESETS)),
+          convert=lambda name: _preset_name(name)),
+    Param('inertia', 'double[3]', lambda node: [float(v) for v in _preset(node).moments],
+          'preset', 'Principal moments [I1, I2, I3] (kg m^2), body = principal frame; positive '
+          'and satisfying I1 + I2 >= I3 and permutations. A change keeps attitude and angular '
+          'velocity.'),
+    Param('inertia_tensor', 'double[6]', None, 'unset',
+          'Full tensor [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] (kg m^2, tensor elements as in URDF) in '
+          'the body frame; overrides inertia.'),
+    Param('initial_orientation', 'double[4]', lambda node: [float(v) for v in _preset(node).q0],
+          'preset', 'Initial attitude (x, y, z, w), body -> world; normalised. Used at start '
+          'and on ~/reset.', convert=_orientation),
+    Param('initial_angular_velocity', 'double[3]',
+          lambda node: [float(v) for v in _preset(node).omega0], 'preset',
+          'Initial angular velocity (rad/s) in the body frame. Used at start and on ~/reset.'),
+    Param('integrator', 'string', 'exact', '`exact`',
+          'Integration method, exact or rk4 (exact4 and dop853 were removed: exact is more '
+          'accurate under torque and cheaper); a change continues from the current state.',
+          choices=tuple(sorted(INTEGRATORS)), convert=_integrator),
+    Param('integration_rate', 'double', lambda node: float(_preset(node).integration_rate),
+          '1000.0 Hz', 'Integration steps per simulated second (Hz); dt = 1 / rate.',
+          low=1e-6, high=1e5, read_only=True),
+    Param('publish_rate', 'double', lambda node: float(_preset(node).publish_rate), '100.0 Hz',
+          'State messages per simulated second (Hz); at most integration_rate, rounded to a '
+          'whole number of steps.', low=1e-6, high=1e5),
+    Param('real_time_factor', 'double', lambda node: float(_preset(node).real_time_factor),
+          '1.0', 'Simulated seconds per wall second on the steady clock; 0 = as fast as '
+          'possible.', low=0.0, high=1e12),
+    Param('publish_clock', 'bool', False, 'false',
+          'Publish the simulated time on /clock (stamps then start at 0) so that other nodes '
+          'can run with use_sim_time.', read_only=True),
+    Param('torque_timeout', 'double', 0.5, '0.5 s',
+          'A torque command is held until replaced or until this long (s, steady clock) after '
+          'it arrived; 0 = hold forever.', low=0.0, high=1e9),
+    Param('max_torque', 'double', 0.0, '0.0 N m',
+          'Per-axis limit on the commanded torque (N m); larger values are clipped and '
+          'counted. 0 = no limit.', low=0.0, high=1e30),
+    Param('world_frame', 'string', 'odom', '`odom`',
+          'Inertial frame id (REP 105) of orientation, angular_momentum and odom.',
+          read_only=True),
+    Param('body_frame', 'string', 'base_link', '`base_link`',
+          'Body frame id of angular_velocity, angular_momentum_body, applied_torque, imu.',
+          read_only=True),
+    Param('thread_priority', 'int', 0, '0',
+          'SCHED_FIFO priority (1-99) of the integration thread on Linux, for fewer missed '
+          'deadlines on a loaded machine; 0 = normal scheduling. Needs CAP_SYS_NICE or an '
+          'rtprio limit (limits.conf); if refused, the node says so and runs normally.',
+          low=0, high=99, read_only=True),
+    Param('publish_imu', 'bool', True, 'true',
+          'Also publish sensor_msgs/Imu on imu (REP 145; no acceleration).', read_only=True),
+], cross_checks=(_body, _publish_rate))
+
+
+def _preset_name(name):
+    if name not in presets.PRESETS:
+        try:
+            presets.get(name)
+        except ValueError as err:
+            raise ConfigurationError(str(err)) from None
+    return name
+
+
 class AttitudeSimulator(Node):
     """
     The attitude_simulator node. ``kwargs`` go to rclpy's Node (context, overrides).
@@ -105,15 +213,12 @@ class AttitudeSimulator(Node):
         super().__init__(NODE_NAME, **kwargs)
         self._stop = threading.Event()
         self._thread = None
-        self._declare_parameters()
-        values = self._validate({p: self.get_parameter(p).value for p in self._dynamic})
-        self._frames = (self.get_parameter('world_frame').value,
-                        self.get_parameter('body_frame').value)
-        self._publish_clock = self.get_parameter('publish_clock').value
-        self.thread_priority = self.get_parameter('thread_priority').value
-        rate = as_float('integration_rate', self.get_parameter('integration_rate').value,
-                        1e-6, 1e5)
-        self._rate = rate
+        values = PARAMETERS.validate(PARAMETERS.declare(self))
+        self._preset = presets.get(values['preset'])
+        self._frames = (values['world_frame'], values['body_frame'])
+        self._publish_clock = values['publish_clock']
+        self.thread_priority = values['thread_priority']
+        self._rate = rate = values['integration_rate']
         self._warnings = ThrottledWarnings(self.get_logger())
         start_ns = 0 if self._publish_clock else self.get_clock().now().nanoseconds
         self.body = BodySimulation(
@@ -137,122 +242,14 @@ class AttitudeSimulator(Node):
             f'{rtf:g}{" (as fast as possible)" if rtf == 0 else ""}')
 
     # ------------------------------------------------------------------ parameters
-    def _declare_parameters(self):
-        preset_name = self.declare_parameter(
-            'preset', presets.DEFAULT,
-            descriptor('Named body from physics/presets.py; its values are the defaults of '
-                       'the parameters below, which override them.', read_only=True,
-                       constraints='one of: ' + ', '.join(sorted(presets.PRESETS)))).value
-        try:
-            self._preset = preset = presets.get(preset_name)
-        except ValueError as err:
-            raise ConfigurationError(str(err)) from None
-        num = {'dynamic_typing': True}
-        self._dynamic = []
-
-        def declare(name, default, desc):
-            self.declare_parameter(name, default, desc)
-            self._dynamic.append(name)
-
-        declare('inertia', [float(v) for v in preset.moments], descriptor(
-            'Principal moments [I1, I2, I3] (kg m^2), body = principal frame; positive and '
-            'satisfying I1 + I2 >= I3 and permutations. A change keeps attitude and angular '
-            'velocity.', **num))
-        self.declare_parameter('inertia_tensor', None, descriptor(
-            'Optional full tensor [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] (kg m^2, tensor elements as in '
-            'URDF) in the body frame; overrides inertia. Unset by default.', **num))
-        self._dynamic.append('inertia_tensor')
-        declare('initial_orientation', [float(v) for v in preset.q0], descriptor(
-            'Initial attitude (x, y, z, w), body -> world; normalised. Used at start and on '
-            '~/reset.', **num))
-        declare('initial_angular_velocity', [float(v) for v in preset.omega0], descriptor(
-            'Initial angular velocity (rad/s) in the body frame. Used at start and on ~/reset.',
-            **num))
-        declare('integrator', 'exact', descriptor(
-            'Integration method; a change continues from the current state.',
-            constraints='one of: ' + ', '.join(sorted(INTEGRATORS))))
-        self.declare_parameter('integration_rate', float(preset.integration_rate), descriptor(
-            'Integration steps per simulated second (Hz); dt = 1 / rate.', read_only=True,
-            low=1e-6, high=1e5, **num))
-        declare('publish_rate', float(preset.publish_rate), descriptor(
-            'State messages per simulated second (Hz); at most integration_rate, rounded to a '
-            'whole number of steps.', low=1e-6, high=1e5, **num))
-        declare('real_time_factor', float(preset.real_time_factor), descriptor(
-            'Simulated seconds per wall second on the steady clock; 0 = as fast as possible.',
-            low=0.0, high=1e12, **num))
-        self.declare_parameter('publish_clock', False, descriptor(
-            'Publish the simulated time on /clock (stamps then start at 0) so that other nodes '
-            'can run with use_sim_time.', read_only=True))
-        declare('torque_timeout', 0.5, descriptor(
-            'A torque command is held until replaced or until this long (s, steady clock) '
-            'after it arrived; 0 = hold forever.', low=0.0, high=1e9, **num))
-        declare('max_torque', 0.0, descriptor(
-            'Per-axis limit on the commanded torque (N m); larger values are clipped and '
-            'counted. 0 = no limit.', low=0.0, high=1e30, **num))
-        self.declare_parameter('world_frame', 'odom', descriptor(
-            'Inertial frame id (REP 105) of orientation, angular_momentum and odom.',
-            read_only=True))
-        self.declare_parameter('body_frame', 'base_link', descriptor(
-            'Body frame id of angular_velocity, angular_momentum_body, applied_torque, imu.',
-            read_only=True))
-        self.declare_parameter('thread_priority', 0, descriptor(
-            'SCHED_FIFO priority (1-99) of the integration thread on Linux, for fewer missed '
-            'deadlines on a loaded machine; 0 = normal scheduling. Needs CAP_SYS_NICE or an '
-            'rtprio limit (limits.conf); if refused, the node says so and runs normally.',
-            read_only=True, low=0, high=99, integer=True))
-        self.declare_parameter('publish_imu', True, descriptor(
-            'Also publish sensor_msgs/Imu on imu (REP 145; no acceleration).', read_only=True))
-
-    def _validate(self, values):
-        """
-        Check parameter values and return them converted; raise ConfigurationError.
-
-        ``values`` maps names to new values merged over the current ones. Free
-        of side effects (used by the on-set callback).
-        """
-        out = dict(values)
-        tensor = values.get('inertia_tensor')
-        try:
-            if tensor is not None and len(tensor) > 0:
-                out['inertia_tensor'] = as_vector('inertia_tensor', tensor, 6)
-                out['body'] = Inertia.from_tensor(out['inertia_tensor'])
-            else:
-                out['body'] = Inertia(as_vector('inertia', values['inertia'], 3))
-        except ValueError as err:
-            raise ConfigurationError(str(err)) from None
-        q = as_vector('initial_orientation', values['initial_orientation'], 4)
-        norm = math.sqrt(sum(c * c for c in q))
-        if norm < 1e-9:
-            raise ConfigurationError('initial_orientation must not be the zero quaternion')
-        out['initial_orientation'] = tuple(c / norm for c in q)
-        out['initial_angular_velocity'] = as_vector(
-            'initial_angular_velocity', values['initial_angular_velocity'], 3)
-        if values['integrator'] not in INTEGRATORS:
-            raise ConfigurationError(REMOVED_INTEGRATORS.get(values['integrator']) or (
-                f'unknown integrator {values["integrator"]!r}; choose one of '
-                f'{", ".join(sorted(INTEGRATORS))}'))
-        rate = getattr(self, '_rate', None) or as_float(
-            'integration_rate', self.get_parameter('integration_rate').value, 1e-6, 1e5)
-        out['publish_rate'] = as_float('publish_rate', values['publish_rate'], 1e-6, rate)
-        out['real_time_factor'] = as_float('real_time_factor', values['real_time_factor'],
-                                           0.0, 1e12)
-        out['torque_timeout'] = as_float('torque_timeout', values['torque_timeout'], 0.0, 1e9)
-        out['max_torque'] = as_float('max_torque', values['max_torque'], 0.0, 1e30)
-        return out
-
     def _on_set_parameters(self, params):
-        values = {p: self.get_parameter(p).value for p in self._dynamic}
-        for param in params:
-            if param.name in values:
-                values[param.name] = param.value
-        return check_change(self.get_logger(), self._validate, values)
+        return PARAMETERS.on_set(self, params)
 
     def _post_set_parameters(self, params):
         names = {p.name for p in params}
-        if not names & set(self._dynamic):
+        if not names & set(PARAMETERS.params):
             return
-        values = self._validate({p: self.get_parameter(p).value for p in self._dynamic})
-        self._apply(values, changed=names)
+        self._apply(PARAMETERS.validate(PARAMETERS.values(self)), changed=names)
 
     def _publish_every(self, publish_rate):
         return max(1, round(self._rate / publish_rate))
