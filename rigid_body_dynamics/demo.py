@@ -12,8 +12,6 @@ conservation), then the tennis racket (instability, growth rate, flips).
 
 import argparse
 import os
-import signal
-import subprocess
 import sys
 import time
 
@@ -84,11 +82,9 @@ def run_nodes(preset, integrator, rate):
     simulated time; the analyzer's window is sized to a few periods of what
     the body does. Returns the printable lines.
     """
-    import rclpy
-    from rclpy.context import Context
-    from rclpy.executors import SingleThreadedExecutor
     from diagnostic_msgs.msg import DiagnosticArray
 
+    from .nodes.client import interrupt, RosClient, start_node, WaitTimeout
     from .nodes.conversions import status_values
     body = presets.get(preset)
     kind = FreeRigidBody(body.moments, body.omega0).shape.kind
@@ -97,22 +93,16 @@ def run_nodes(preset, integrator, rate):
     rtf = 8.0 if kind == 'asymmetric' else 4.0
 
     def start(node, *params):
-        cmd = [sys.executable, '-m', f'rigid_body_dynamics.nodes.{node}', '--ros-args',
-               '--log-level', 'warn']
+        args = ['--log-level', 'warn']
         for p in params:
-            cmd += ['-p', p]
-        return subprocess.Popen(cmd)
+            args += ['-p', p]
+        return start_node(node, args)
     sim = start('simulator', f'preset:={preset}', f'integrator:={integrator}',
                 f'integration_rate:={rate}', f'real_time_factor:={rtf}', 'publish_clock:=true')
     analyzer = start('analyzer', f'window:={window}')
     print(f'{preset}: started attitude_simulator (pid {sim.pid}, {integrator}, {rtf:g}x real '
           f'time) and attitude_analyzer (pid {analyzer.pid}, window {window:g} s) ...',
           flush=True)
-    ctx = Context()
-    rclpy.init(context=ctx)
-    node = rclpy.create_node('rigid_body_demo', context=ctx)
-    executor = SingleThreadedExecutor(context=ctx)
-    executor.add_node(node)
     statuses = {}
     first = {}
 
@@ -124,33 +114,24 @@ def run_nodes(preset, integrator, rate):
                 statuses[name] = (st.level, st.message, values)
                 if key in values and _is_number(values[key]):
                     first.setdefault(name, time.monotonic())
-    node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 10)
-    deadline = time.monotonic() + 60.0 + window / rtf
-    try:
+
+    def ready():
         # findings are ready once the window is full: a window's worth of wall time after
         # the first estimate
-        while time.monotonic() < deadline:
-            if check in first and time.monotonic() > first[check] + window / rtf + 1.0:
-                break
-            for proc, name in ((sim, 'attitude_simulator'), (analyzer, 'attitude_analyzer')):
-                if proc.poll() is not None:
-                    raise RuntimeError(f'{name} exited with code {proc.returncode}')
-            executor.spin_once(timeout_sec=0.05)
+        for proc, name in ((sim, 'attitude_simulator'), (analyzer, 'attitude_analyzer')):
+            if proc.poll() is not None:
+                raise RuntimeError(f'{name} exited with code {proc.returncode}')
+        return check in first and time.monotonic() > first[check] + window / rtf + 1.0
+    client = RosClient('rigid_body_demo')
+    try:
+        client.node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 10)
+        client.spin_until(ready, 60.0 + window / rtf, "the analyzer's findings")
+    except WaitTimeout:
+        if check not in first:
+            raise RuntimeError('the analyzer reported no findings in time') from None
     finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.shutdown(context=ctx)
-        codes = []
-        for proc in (analyzer, sim):
-            if proc.poll() is None:
-                proc.send_signal(signal.SIGINT)
-                try:
-                    proc.wait(10.0)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
-            codes.append(proc.returncode)
-    if check not in first:
-        raise RuntimeError('the analyzer reported no findings in time')
+        client.close()
+        codes = [interrupt(proc) for proc in (analyzer, sim)]
     lines = [f'{body.name}: {body.description}',
              f'  I = {body.moments} kg m^2, omega0 = {body.omega0} rad/s body; '
              'attitude_analyzer finds:'] + findings(statuses)

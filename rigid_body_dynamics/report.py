@@ -24,7 +24,6 @@ import html
 import math
 import os
 import sys
-import time
 
 import numpy as np
 
@@ -51,33 +50,27 @@ def record(path, duration, timeout=60.0):
     ``duration`` s of odom stamps and the inertia are in. Returns the bag's
     Trajectory (read back with :func:`~rigid_body_dynamics.bags.read_trajectory`).
     """
-    import rclpy
-    from rclpy.context import Context
-    from rclpy.executors import SingleThreadedExecutor
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
     from rclpy.serialization import deserialize_message
     from geometry_msgs.msg import InertiaStamped, WrenchStamped
     from nav_msgs.msg import Odometry
+    from .nodes.client import RosClient, WaitTimeout
     from .samples import stamp_ns
-    ctx = Context()
-    rclpy.init(context=ctx)
-    node = rclpy.create_node('rigid_body_report', context=ctx)
-    executor = SingleThreadedExecutor(context=ctx)
-    executor.add_node(node)
     stamps, inertia, out = [], [], {}
     deep = QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE)
     latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    with RosClient('rigid_body_report') as client:
+        node = client.node
 
-    def keep(name):
-        def on_message(raw):
-            out['writer'].write(name, node.get_clock().now().nanoseconds, raw)
-            if name.endswith('odom'):
-                stamps.append(stamp_ns(deserialize_message(raw, Odometry).header.stamp))
-            elif name.endswith('inertia'):
-                inertia.append(True)
-        return on_message
-    try:
+        def keep(name):
+            def on_message(raw):
+                out['writer'].write(name, node.get_clock().now().nanoseconds, raw)
+                if name.endswith('odom'):
+                    stamps.append(stamp_ns(deserialize_message(raw, Odometry).header.stamp))
+                elif name.endswith('inertia'):
+                    inertia.append(True)
+            return on_message
         topics = {}
         for topic, msg_type, type_name, qos in (
                 ('odom', Odometry, ODOMETRY, deep),
@@ -89,14 +82,12 @@ def record(path, duration, timeout=60.0):
             node.create_subscription(msg_type, topic, keep(name), qos, raw=True)
         with BagWriter(path, topics, 'mcap') as writer:
             out['writer'] = writer
-            deadline = time.monotonic() + timeout + duration
-            while time.monotonic() < deadline and not (
-                    inertia and stamps and (max(stamps) - min(stamps)) * 1e-9 >= duration):
-                executor.spin_once(timeout_sec=0.05)
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.shutdown(context=ctx)
+            try:
+                client.spin_until(lambda: inertia and stamps and (
+                    max(stamps) - min(stamps)) * 1e-9 >= duration, timeout + duration,
+                    f'{duration:g} s of odom')
+            except WaitTimeout:
+                pass        # said below if nothing usable came
     if not inertia or len(stamps) < 3:
         raise BagError(f'nothing usable recorded into {path}: is attitude_simulator running '
                        'in this domain?')

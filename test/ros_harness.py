@@ -8,18 +8,14 @@ test side is an rclpy node in its own Context. Every wait has a deadline.
 """
 
 import os
-import signal
 import subprocess
-import sys
 import time
 
 from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
-import rclpy
-from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rigid_body_dynamics.nodes.client import interrupt, RosClient, start_node  # noqa: F401
 from rigid_body_dynamics.nodes.conversions import quaternion_array, quaternion_msg, status_values
 from rigid_body_dynamics.nodes.conversions import time_msg, time_ns, vector_array, vector_msg
 from rigid_body_dynamics.physics import FreeRigidBody, quaternions
@@ -32,18 +28,6 @@ TORQUE_UNIT = 1e-9
 LATCHED = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                      reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
-
-
-def interrupt(proc, timeout=10.0):
-    """SIGINT a subprocess.Popen (as Ctrl-C does) and wait; kill after ``timeout`` s; exit code."""
-    if proc.poll() is None:
-        proc.send_signal(signal.SIGINT)
-        try:
-            proc.wait(timeout)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(5.0)
-    return proc.returncode
 
 
 def stamp(msg):
@@ -151,9 +135,7 @@ class NodeProcess:
     def __init__(self, module, ros_args=(), log_dir=None, name='node'):
         self.log_path = os.path.join(log_dir or os.environ['ROS_LOG_DIR'], f'{name}.log')
         self._log = open(self.log_path, 'w')
-        self.proc = subprocess.Popen(
-            [sys.executable, '-m', module, '--ros-args', *ros_args],
-            stdout=self._log, stderr=subprocess.STDOUT, env=os.environ.copy())
+        self.proc = start_node(module, ros_args, stdout=self._log, stderr=subprocess.STDOUT)
 
     def output(self):
         """Everything the process printed so far."""
@@ -176,15 +158,11 @@ class NodeProcess:
         return code
 
 
-class Probe:
+class Probe(RosClient):
     """A test-side node in its own Context: subscribe, publish, call services, with deadlines."""
 
     def __init__(self, name='probe'):
-        self.context = Context()
-        rclpy.init(context=self.context)
-        self.node = rclpy.create_node(name, context=self.context)
-        self.executor = SingleThreadedExecutor(context=self.context)
-        self.executor.add_node(self.node)
+        super().__init__(name)
         self.messages = {}
 
     def subscribe(self, msg_type, topic, qos=DEEP):
@@ -192,20 +170,6 @@ class Probe:
         store = self.messages.setdefault(topic, [])
         self.node.create_subscription(msg_type, topic, store.append, qos)
         return store
-
-    def spin_until(self, predicate, timeout, what='condition'):
-        """Spin until ``predicate()`` holds; AssertionError naming ``what`` after ``timeout``."""
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline:
-                raise AssertionError(f'timed out after {timeout} s waiting for {what}')
-            self.executor.spin_once(timeout_sec=0.02)
-
-    def spin_for(self, seconds):
-        """Spin for a fixed time (collecting messages)."""
-        deadline = time.monotonic() + seconds
-        while time.monotonic() < deadline:
-            self.executor.spin_once(timeout_sec=0.02)
 
     def wait_for(self, topic, count=1, timeout=20.0):
         """Spin until ``count`` messages arrived on ``topic``; returns the list."""
@@ -265,9 +229,3 @@ class Probe:
                 if status.name.endswith(name):
                     return status.level, status.message, status_values(status)
         return None
-
-    def close(self):
-        """Tear down node, executor and context."""
-        self.executor.shutdown()
-        self.node.destroy_node()
-        rclpy.shutdown(context=self.context)
