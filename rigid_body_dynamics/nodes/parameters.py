@@ -106,11 +106,11 @@ class Param:
 
     def descriptor(self):
         """Build the ParameterDescriptor of this parameter."""
-        numeric = self.kind.startswith('double') or self.kind == 'int'
         constraints = f'one of: {", ".join(self.choices)}' if self.choices else ''
+        # doubles take integers too (-p inertia:=[1,2,3]); an int stays strictly typed
         return descriptor(self.text, read_only=self.read_only, low=self.low, high=self.high,
                           constraints=constraints, integer=self.kind == 'int',
-                          dynamic_typing=numeric)
+                          dynamic_typing=self.kind.startswith('double'))
 
     def check(self, value):
         """Return the value converted, or raise ConfigurationError saying why."""
