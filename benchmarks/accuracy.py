@@ -1,7 +1,7 @@
 """
 Accuracy against cost for the free rigid body: our integrators and scipy's solve_ivp.
 
-Case (numerics.md section 3): I = (1, 2, 3) kg m^2, m0 = (1, 1, 18), so
+Case: I = (1, 2, 3) kg m^2, m0 = (1, 1, 18), so
 omega0 = (1, 0.5, 6) rad/s and |omega| h = 6e-3 at 1 kHz. Errors are the
 largest over samples every 1000 steps against the exact solution evaluated
 in one shot from t = 0.

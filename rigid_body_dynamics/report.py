@@ -153,7 +153,7 @@ def make_report(run, out_dir):
     w_world = quaternions.rotate(q, w)
     l_world = quaternions.rotate(q, moments * w)
     normal = l_world[0] / np.linalg.norm(l_world[0])
-    e1, e2, _ = estimators._basis_perpendicular(normal)
+    e1, e2, _ = estimators.basis_perpendicular(normal)
     plane = np.stack([w_world @ e1, w_world @ e2], axis=1)
     fig, ax = _figure('Herpolhode: omega in the invariant plane (world frame, normal L)',
                       'along e_u (rad/s)', 'along e_v (rad/s)')

@@ -353,3 +353,23 @@ def test_twist_frames_are_honoured(launch, probe):
     assert int(values['dropped samples in another frame']) == wrong
     assert values['body frame'] == 'base_link'
     stop_cleanly(analyzer)
+
+
+def test_clearing_the_inertia_parameter_falls_back_to_the_topic(launch, probe):
+    """With the inertia parameter unset again (an empty list), the latched topic is used."""
+    from geometry_msgs.msg import InertiaStamped
+    from ros_harness import LATCHED
+    analyzer = launch(ANALYZER, '-p', 'inertia:=[1.0, 1.0, 1.5]', name='analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    latched = InertiaStamped()
+    latched.header.frame_id = 'base_link'
+    latched.inertia.ixx, latched.inertia.iyy, latched.inertia.izz = 1.0, 1.0, 2.0
+    probe.node.create_publisher(InertiaStamped, 'inertia', LATCHED).publish(latched)
+    wait_status(probe, 'input', lambda v: v.get('inertia source') == 'parameter', 20.0,
+                'the parameter in use')
+    probe.spin_for(1.0)                                  # the topic arrives and is ignored
+    assert set_params(probe, inertia=[]).successful          # an empty list unsets it
+    level, message, values = wait_status(
+        probe, 'input', lambda v: v.get('inertia source') == 'topic', 20.0, 'the topic in use')
+    assert values['body frame'] == 'base_link'
+    stop_cleanly(analyzer)

@@ -8,7 +8,7 @@ import pytest
 from rigid_body_dynamics.physics import estimators, FreeRigidBody, simulate, theory
 
 MOMENTS = (1.0, 1.0, 1.5)
-OMEGA0 = (0.5, 0.0, 10.0)   # Omega = 5 rad/s, as in numerics.md section 2.6
+OMEGA0 = (0.5, 0.0, 10.0)   # Omega = 5 rad/s
 
 
 def messy_stamps(rng, n=18000, span=18.0, drop=0.1):

@@ -325,8 +325,8 @@ def test_rotated_tensor_publishes_in_the_users_body_frame(launch, probe):
     stop_cleanly(proc)
 
 
-@pytest.mark.parametrize('signal_name', ['SIGTERM'])
-def test_sigterm_exits_zero(launch, probe, signal_name):
+@pytest.mark.parametrize('signal_name', ['SIGTERM', 'SIGINT'])
+def test_signals_exit_zero(launch, probe, signal_name):
     import signal
     proc = launch(SIM, name='sim')
     probe.subscribe(Odometry, 'odom')
@@ -361,8 +361,12 @@ def test_thread_priority_is_applied_or_refused_with_the_reason(launch, probe):
     odom = probe.subscribe(Odometry, 'odom')
     probe.wait_for('odom', 20)
     output = proc.output()
-    assert ('SCHED_FIFO at priority 10' in output) or ('SCHED_FIFO refused' in output)
-    if 'SCHED_FIFO at priority 10' in output:   # one thread really runs under it
-        assert (1, 10) in thread_policies(proc.proc.pid)
-    assert len(odom) >= 20
+    assert len(odom) >= 20                         # runs either way
+    if 'SCHED_FIFO refused' in output:
+        assert 'integration thread keeps normal scheduling' in output
+        stop_cleanly(proc)
+        pytest.skip('this machine refuses SCHED_FIFO (no CAP_SYS_NICE / rtprio limit): '
+                    'the refusal was logged and the node ran normally')
+    assert 'SCHED_FIFO at priority 10' in output
+    assert (1, 10) in thread_policies(proc.proc.pid)   # one thread really runs under it
     stop_cleanly(proc)

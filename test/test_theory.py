@@ -113,7 +113,7 @@ def test_period_and_mean_precession_against_exact_motion(moments, omega0):
     np.testing.assert_allclose(w[-1], w[0], atol=1e-11)       # periodic in the body
     lw = equations.angular_momentum_world(np.array(moments), q, w)
     for axis in range(3):
-        u, v, _ = estimators._basis_perpendicular(lw[0])
+        u, v, _ = estimators.basis_perpendicular(lw[0])
         e = quaternions.rotate(q, np.eye(3)[axis])
         turned = np.unwrap(np.arctan2(e @ v, e @ u))
         assert (turned[-1] - turned[0]) / t[-1] == pytest.approx(

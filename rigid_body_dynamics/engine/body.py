@@ -106,6 +106,7 @@ class BodySimulation:
     def _baseline(self):
         """Remember T and L_w now: drift is reported since the last torque or change."""
         self.base = self.invariants()
+        self._base_stale = False
 
     def invariants(self):
         """(T in J, L_w in kg m^2/s, world frame) of the current state."""
@@ -234,13 +235,15 @@ class BodySimulation:
     def advance(self, now_ns, outbox):
         """One integration step (call under ``lock``); a publish tick's snapshot goes to outbox."""
         torque, torque_world = self.torque_now(now_ns)
+        torqued = torque_world is not None or torque[0] or torque[1] or torque[2]
+        if self._base_stale and not torqued:
+            self._baseline()          # the state after the last step under torque
         self.stepper.step(torque, torque_world)
         self.steps += 1
         if torque_world is not None:
             q = self.stepper.q
             torque = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), torque_world)
-        if torque[0] or torque[1] or torque[2]:
-            self._baseline()
+        self._base_stale = self._base_stale or bool(torqued)
         self.last_torque = torque
         if self.steps % self.publish_every == 0:
             outbox.append(self.snapshot())
@@ -263,6 +266,9 @@ class BodySimulation:
         """
         with self.lock:
             s = self.stepper
+            if self._base_stale:      # under torque: drift since the latest torque step
+                self._baseline()
+                self._base_stale = True
             t0, l0 = self.base
             t1, l1 = self.invariants()
             g0 = math.sqrt(sum(c * c for c in l0))

@@ -183,6 +183,7 @@ class AttitudeAnalyzer(Node):
         self._baseline_floor = _ALWAYS         # ns: the baseline is a sample at/after this
         self._last_torque = _ALWAYS            # ns: stamp of the newest non-zero torque
         self._body_frame = None                # frame id of the inertia, when known
+        self._topic_inertia = (None, None)     # the latched topic's (Inertia, frame id)
         self._restarts = {'reset': 0, 'gap': 0, 'non_finite': 0, 'wrong_frame': 0}
         self._received = 0
         self._last_arrival = None
@@ -211,20 +212,27 @@ class AttitudeAnalyzer(Node):
 
     def _post_set_parameters(self, params):
         settings = PARAMETERS.validate(PARAMETERS.values(self))
-        if 'inertia' in {p.name for p in params} and settings['inertia'] is not None:
-            self._inertia, self._inertia_source = settings['inertia'], 'parameter'
-            self._restart('inertia changed')
+        if 'inertia' in {p.name for p in params}:
+            if settings['inertia'] is not None:
+                self._inertia, self._inertia_source = settings['inertia'], 'parameter'
+                self._restart('inertia changed')
+            elif self._inertia_source == 'parameter':
+                # cleared: back to the latched topic (its last message, if one came)
+                self._inertia, self._body_frame = self._topic_inertia
+                self._inertia_source = 'topic' if self._inertia is not None else None
+                self._restart('inertia parameter cleared: using the inertia topic')
         self._settings = settings
 
     # ---------------------------------------------------------------- inputs
     def _on_inertia(self, msg):
-        if self._inertia_source == 'parameter':
-            return
         tensor, frame = samples.inertia_tensor(msg)
         try:
             body = Inertia.from_tensor(tensor)
         except ValueError as err:
             self.get_logger().error(f'inertia topic refused: {err}')
+            return
+        self._topic_inertia = (body, frame or None)
+        if self._inertia_source == 'parameter':
             return
         self._body_frame = frame or None
         if self._inertia is None or not np.allclose(body.tensor, self._inertia.tensor):

@@ -1,7 +1,8 @@
 """
 attitude_simulator: integrates Euler's equations and publishes the attitude state.
 
-Topics, frames and parameters follow DESIGN.md (see README for the list).
+Topics, frames and parameters are listed in the README (the parameter list is
+made from ``PARAMETERS`` below).
 The node is thin: it keeps the parameters, the torque subscription, the
 services and the diagnostics; the body is an engine
 :class:`~rigid_body_dynamics.engine.body.BodySimulation` (ROS-free), paced by

@@ -531,7 +531,7 @@ def _asymmetric_precession(t, q, w, moments, tol):
     except ValueError as err:
         omega_period = unavailable(str(err), period, 's')
     lw = equations.angular_momentum_world(moments, q, w)
-    u, v, _ = estimators._basis_perpendicular(lw.mean(axis=0))
+    u, v, _ = estimators.basis_perpendicular(lw.mean(axis=0))
     e = quaternions.rotate(q, np.eye(3)[axis])
     rate, periods = _mean_rate_over_periods(t, np.arctan2(e @ v, e @ u), period)
     mean = compare(rate, mean_theory, tol.rate, 'rad/s')

@@ -43,8 +43,8 @@ def angle_rate(t, angle):
     """
     Rate (rad/s) of an angle (rad) from unwrap + least-squares slope on centred stamps.
 
-    numerics.md section 2.6: beats endpoint and FFT estimators on noisy,
-    irregular data. Needs at least 3 samples.
+    On noisy, irregular samples this beats endpoint differences and FFT peaks
+    (the fit uses every sample). Needs at least 3 samples.
     """
     t, angle = sort_samples(t, angle)
     if t.size < 3:
@@ -75,7 +75,7 @@ def body_precession_rate(t, omega, axis=2):
     return angle_rate(t, np.arctan2(w[:, b], w[:, a]))
 
 
-def _basis_perpendicular(n):
+def basis_perpendicular(n):
     """Return unit vectors u, v with (u, v, n) right-handed."""
     n = np.asarray(n, dtype=float)
     n = n / np.linalg.norm(n)
@@ -96,7 +96,7 @@ def lab_precession_rate(t, q, omega, moments, axis=2):
     """
     t, q, w = sort_samples(t, q, omega)
     lw = equations.angular_momentum_world(moments, q, w)
-    u, v, _ = _basis_perpendicular(lw.mean(axis=0))
+    u, v, _ = basis_perpendicular(lw.mean(axis=0))
     e = quaternions.rotate(q, np.eye(3)[axis])
     return angle_rate(t, np.arctan2(e @ v, e @ u))
 

@@ -15,9 +15,10 @@ body (I1 < I2 < I3 after sorting) with G = |m|, 2T = sum m_i^2 / I_i:
   circled axis and psi is the angle about it, integrated in closed form with
   the incomplete elliptic integral of the third kind (Carlson R_F, R_J).
 
-The recipe is the re-derivation in shared/research/numerics.md section 1a
-(after Celledoni, Fasso, Safstrom & Zanna, SIAM J. Sci. Comput. 30, 2008, with
-the corrections of its erratum); tests check it against DOP853 at rtol 1e-13.
+The recipe is re-derived here after Celledoni, Fasso, Safstrom & Zanna (SIAM
+J. Sci. Comput. 30, 2008), with the corrections of its erratum (sign of
+lambda, the value of n in Pi, the sign of the arctan term); the formulas are
+in the functions below, and tests check them against DOP853 at rtol 1e-13.
 Axisymmetric and spherical bodies use their elementary closed forms.
 
 Near the separatrix (|S| / G^2 < SEPARATRIX_THRESHOLD) scipy's ``ellipj``,

@@ -5,10 +5,11 @@ Every integrator advances the state (q, omega) of one body by a fixed step dt
 (s) under a torque held constant over the step (a zero-order hold):
 ``torque`` fixed in the body frame and, optionally, ``torque_world`` fixed in
 the world frame (both N m; the world part is rotated into the body wherever
-the method evaluates the torque). The state is kept in the principal frame:
-``moments`` are the principal moments (kg m^2) in the order of the body axes,
-omega (rad/s) is body-frame, q (x, y, z, w) rotates body vectors into the
-world frame.
+the method evaluates the torque). The state is kept in the principal frame
+of the inertia (the body frame when the tensor is diagonal; ``Inertia``
+converts between the two): ``moments`` are the principal moments (kg m^2),
+omega (rad/s) and the body torque are principal-frame components, and q
+(x, y, z, w) rotates principal-frame vectors into the world frame.
 
 Each integrator also books the work W = int omega . tau dt (J) and the
 world-frame impulse H = int R tau dt (N m s), so the balances T - T0 = W and

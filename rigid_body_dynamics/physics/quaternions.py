@@ -1,7 +1,7 @@
 """
 Hamilton quaternion algebra, scalar-last (x, y, z, w).
 
-Conventions (DESIGN.md, REP 103): quaternions are Hamilton (i j = k), unit,
+Conventions (REP 103, as geometry_msgs and scipy): quaternions are Hamilton (i j = k), unit,
 and *active*: q rotates body-frame vectors into the world frame,
 ``v_world = q (x) v_body (x) conj(q)``. This is scipy's
 ``Rotation.from_quat`` convention, which the tests use as ground truth.

@@ -68,9 +68,11 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     :class:`SimulationResult` including t = 0.
     """
     inertia = as_inertia(inertia)
-    n = int(round(duration / dt))
-    if n < 0 or not math.isfinite(duration):
+    if not (math.isfinite(duration) and duration >= 0.0):
         raise ValueError(f'duration must be finite and >= 0, got {duration!r}')
+    if not (math.isfinite(dt) and dt > 0.0):
+        raise ValueError(f'dt must be positive and finite, got {dt!r}')
+    n = int(round(duration / dt))
     q0 = np.asarray(q0, dtype=float)
     stepper = make_integrator(integrator, inertia.moments, dt,
                               inertia.attitude_to_principal(q0 / np.linalg.norm(q0)),

@@ -2,8 +2,8 @@
 Closed-form predictions for the free rigid body.
 
 Each function cites where its formula comes from: the seed text (Shapiro,
-Classical Mechanics, section 4.4, equation numbers as there) or
-shared/research/numerics.md section 2. Units: kg m^2, rad/s, s, J,
+Classical Mechanics, section 4.4, equation numbers as there) or is derived
+in its docstring from the exact solution of ``free_motion``. Units: kg m^2, rad/s, s, J,
 kg m^2/s; vectors in the principal body frame unless named ``_world``.
 """
 
@@ -34,8 +34,8 @@ def lab_precession_rate(i_perp, angular_momentum_norm):
     """
     Lab-frame precession rate |L| / I_perp (rad/s) of the symmetry axis and of omega about L.
 
-    numerics.md section 2.1; equal to :func:`herpolhode_rate` (the seed's
-    Omega sin(phi_b) / sin(phi_L)).
+    Equal to :func:`herpolhode_rate` (the seed's Omega sin(phi_b) / sin(phi_L)):
+    the contact line's speed is the same seen from either cone.
     """
     return angular_momentum_norm / i_perp
 
@@ -180,8 +180,8 @@ def omega_period(moments, omega):
     """
     Period (s) of omega(t) in the body frame.
 
-    Asymmetric body: 4 K(k) / lambda (numerics.md section 2.2), the period of
-    sn and cn. Axisymmetric: 2 pi / |Omega| (:func:`body_precession_rate`).
+    Asymmetric body: 4 K(k) / lambda (k, lambda of the elliptic solution in
+    ``free_motion``), the period of sn and cn. Axisymmetric: 2 pi / |Omega| (:func:`body_precession_rate`).
     Infinite for a spin about a principal axis, a sphere, or the separatrix.
     """
     shape, par = _sorted_parameters(moments, omega)
@@ -202,7 +202,7 @@ def flip_interval(moments, omega):
     """
     Time (s) between successive flips of a spin near the intermediate axis: 2 K / lambda.
 
-    Half the period of omega(t) (numerics.md section 2.3): the intermediate
+    Half the period of omega(t): the intermediate
     component changes sign once per half period (tennis-racket theorem).
     """
     return 0.5 * omega_period(moments, omega)
@@ -229,7 +229,7 @@ def mean_precession_rate(moments, omega, axis=None):
     The attitude returns after one period of omega up to a rotation by
     dpsi about L (right-handed about +L); a body axis that the polhode
     circles picks up one turn more, +2 pi around the largest-moment axis
-    and -2 pi around the smallest (numerics.md section 2.2 gives the first;
+    and -2 pi around the smallest (the first follows from the exact solution;
     the second was measured here, see test_theory). ``axis`` defaults to the
     circled axis. Axisymmetric bodies: |L| / I_perp for the symmetry axis.
     """
