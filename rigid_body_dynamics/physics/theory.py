@@ -181,8 +181,9 @@ def omega_period(moments, omega):
     Period (s) of omega(t) in the body frame.
 
     Asymmetric body: 4 K(k) / lambda (k, lambda of the elliptic solution in
-    ``free_motion``), the period of sn and cn. Axisymmetric: 2 pi / |Omega| (:func:`body_precession_rate`).
-    Infinite for a spin about a principal axis, a sphere, or the separatrix.
+    ``free_motion``), the period of sn and cn. Axisymmetric: 2 pi / |Omega|
+    (:func:`body_precession_rate`). Infinite for a spin about a principal
+    axis, a sphere, or the separatrix.
     """
     shape, par = _sorted_parameters(moments, omega)
     w = np.asarray(omega, dtype=float)
