@@ -14,8 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import cdr, samples
-from .physics import quaternions
+from . import samples
 from .physics.analysis import Trajectory
 from .physics.inertia import Inertia
 
@@ -244,61 +243,22 @@ def _last_segment(t, reset_jump, max_gap, info):
 
 def _odometry(reader, raws, body_frame, info):
     """(t_ns, q, omega body) arrays of raw Odometry messages; frames as samples.py says."""
-    try:
-        t, q, w, world, child = cdr.odometry_arrays(raws)
-        return _frames(t, q, w, world, child, body_frame, info)
-    except cdr.NotUniform:
-        pass
-    t, q, w = [], [], []
-    for raw in raws:
-        try:
-            st, sq, sw = samples.odometry_sample(reader.deserialize(raw, ODOMETRY), body_frame)
-        except samples.FrameError:
-            info.dropped['odom in another frame'] = \
-                info.dropped.get('odom in another frame', 0) + 1
-            continue
-        t.append(st)
-        q.append(sq)
-        w.append(sw)
-    return (np.array(t, dtype=np.int64), np.array(q).reshape(-1, 4),
-            np.array(w).reshape(-1, 3))
-
-
-def _frames(t, q, w, world, child, body_frame, info):
-    """Apply samples.odometry_sample's frame rules to a batch with one world and child frame."""
-    if child and child == world:
-        n = np.linalg.norm(q, axis=1)
-        with np.errstate(invalid='ignore', divide='ignore'):
-            w = quaternions.rotate_inverse(q / n[:, None], w)
-    elif child and body_frame and child != body_frame:
+    t, q, w, dropped = samples.odometry_batch(raws, lambda raw: reader.deserialize(
+        raw, ODOMETRY), body_frame)
+    if dropped:
         info.dropped['odom in another frame'] = info.dropped.get('odom in another frame', 0) \
-            + t.size
-        return t[:0], q[:0], w[:0]
+            + dropped
     return t, q, w
 
 
 def _torques(reader, raws, body_frame, info):
     """(t_ns, torque body) arrays of raw WrenchStamped messages."""
-    try:
-        t, tau, frame = cdr.wrench_arrays(raws)
-        if frame and body_frame and frame != body_frame:
-            info.dropped['torque in another frame'] = \
-                info.dropped.get('torque in another frame', 0) + t.size
-            return t[:0], tau[:0]
-        return t, tau
-    except cdr.NotUniform:
-        pass
-    t, tau = [], []
-    for raw in raws:
-        try:
-            st, vec = samples.torque_sample(reader.deserialize(raw, WRENCH), body_frame)
-        except samples.FrameError:
-            info.dropped['torque in another frame'] = \
-                info.dropped.get('torque in another frame', 0) + 1
-            continue
-        t.append(st)
-        tau.append(vec)
-    return np.array(t, dtype=np.int64), np.array(tau).reshape(-1, 3)
+    t, tau, dropped = samples.torque_batch(raws, lambda raw: reader.deserialize(raw, WRENCH),
+                                           body_frame)
+    if dropped:
+        info.dropped['torque in another frame'] = \
+            info.dropped.get('torque in another frame', 0) + dropped
+    return t, tau
 
 
 # ---------------------------------------------------------------------------- writing

@@ -15,6 +15,10 @@ is not the frame the inertia belongs to and is refused (:class:`FrameError`).
 
 import math
 
+import numpy as np
+
+from . import cdr
+from .physics import quaternions
 from .physics.quaternions import rotate_components
 
 
@@ -77,3 +81,60 @@ def _to_body(q, v):
     if not n > 0.0:
         return (math.nan,) * 3
     return rotate_components((-q[0] / n, -q[1] / n, -q[2] / n, q[3] / n), v)
+
+
+def odometry_batch(raws, decode, body_frame=None):
+    """
+    Return (t_ns, q, omega body, dropped) from serialised nav_msgs/Odometry messages.
+
+    The frame rules of :func:`odometry_sample`, applied to a batch read with
+    :func:`rigid_body_dynamics.cdr.odometry_arrays`; a batch whose layout
+    differs is decoded message by message with ``decode(raw)``. ``dropped``
+    counts the messages in another frame. Arrays (N,), (N, 4), (N, 3).
+    """
+    try:
+        t, q, w, world, child = cdr.odometry_arrays(raws)
+    except cdr.NotUniform:
+        return _one_by_one(raws, decode, body_frame)
+    if child and child == world:
+        n = np.linalg.norm(q, axis=1)
+        with np.errstate(invalid='ignore', divide='ignore'):
+            w = quaternions.rotate_inverse(q / n[:, None], w)
+    elif child and body_frame and child != body_frame:
+        return t[:0], q[:0], w[:0], int(t.size)
+    return t, q, w, 0
+
+
+def _one_by_one(raws, decode, body_frame):
+    t, q, w, dropped = [], [], [], 0
+    for raw in raws:
+        try:
+            st, sq, sw = odometry_sample(decode(raw), body_frame)
+        except FrameError:
+            dropped += 1
+            continue
+        t.append(st)
+        q.append(sq)
+        w.append(sw)
+    return (np.array(t, dtype=np.int64), np.array(q, dtype=float).reshape(-1, 4),
+            np.array(w, dtype=float).reshape(-1, 3), dropped)
+
+
+def torque_batch(raws, decode, body_frame=None):
+    """Return (t_ns, torque body (N, 3) N m, dropped) from serialised WrenchStamped messages."""
+    try:
+        t, tau, frame = cdr.wrench_arrays(raws)
+    except cdr.NotUniform:
+        t, tau, dropped = [], [], 0
+        for raw in raws:
+            try:
+                st, vec = torque_sample(decode(raw), body_frame)
+            except FrameError:
+                dropped += 1
+                continue
+            t.append(st)
+            tau.append(vec)
+        return np.array(t, dtype=np.int64), np.array(tau, dtype=float).reshape(-1, 3), dropped
+    if frame and body_frame and frame != body_frame:
+        return t[:0], tau[:0], int(t.size)
+    return t, tau, 0

@@ -29,10 +29,12 @@ import numpy as np
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import deserialize_message
 from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
 from . import conversions as conv, diagnostics
+from .intake import Intake
 from .parameters import as_vector, ConfigurationError, Param, ParameterTable
 from .runner import run
 from .throttle import ThrottledWarnings
@@ -43,6 +45,8 @@ from ..physics.analysis import analyse, Tolerances, Trajectory
 NODE_NAME = 'attitude_analyzer'
 #: Samples needed before any rate is estimated.
 MIN_SAMPLES = 20
+#: Period of the batch intake of odom and applied_torque (s, steady clock).
+INTAKE_PERIOD = 0.05
 
 INPUT_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
                        reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -191,8 +195,11 @@ class AttitudeAnalyzer(Node):
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.add_post_set_parameters_callback(self._post_set_parameters)
 
-        self.create_subscription(Odometry, 'odom', self._on_odom, INPUT_QOS)
-        self.create_subscription(WrenchStamped, 'applied_torque', self._on_torque, INPUT_QOS)
+        # odom and applied_torque are taken in batches every INTAKE_PERIOD, not one
+        # executor callback per message (a quarter of a core at 1 kHz)
+        self._intake = Intake(self)
+        self._intake.subscribe(Odometry, 'odom', INPUT_QOS)
+        self._intake.subscribe(WrenchStamped, 'applied_torque', INPUT_QOS)
         self.create_subscription(InertiaStamped, 'inertia', self._on_inertia, LATCHED_QOS)
         self._pub = {name: self.create_publisher(Float64, name, 10) for name in (
             'precession/body_rate', 'precession/lab_rate', 'kinetic_energy',
@@ -200,6 +207,7 @@ class AttitudeAnalyzer(Node):
         self._pub_diag = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self.create_service(Trigger, '~/reset_baseline', self._on_reset_baseline)
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.create_timer(INTAKE_PERIOD, self._drain, clock=self._steady)
         self.create_timer(self._settings['diagnostic_period'], self._analyse, clock=self._steady)
         self.get_logger().info(
             'analysing odom' + (f' with inertia {self._inertia.moments.tolist()} kg m^2'
@@ -241,24 +249,42 @@ class AttitudeAnalyzer(Node):
             self.get_logger().info(f'inertia from topic: {body.moments.tolist()} kg m^2 '
                                    f'in frame {frame!r}')
 
-    def _on_odom(self, msg):
-        self._received += 1
-        self._last_arrival = self._steady.now().nanoseconds
-        try:
-            t, q, w = samples.odometry_sample(msg, self._body_frame)
-        except samples.FrameError as err:
-            self._restarts['wrong_frame'] += 1
-            self._warnings.warn('frame', f'odom sample dropped: {err}')
-            return
-        q, w = np.array(q), np.array(w)
-        norm = float(np.linalg.norm(q))
-        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(w))) or norm < 0.5:
-            self._restarts['non_finite'] += 1
-            self._warnings.warn('non-finite', 'odom sample with a non-finite or zero quaternion '
-                                'or rate dropped')
-            return
+    def _drain(self):
+        """Take every odom and applied_torque message pending (one batch each) and file them."""
+        raws = self._intake.take('odom')
+        if raws:
+            self._received += len(raws)
+            self._last_arrival = self._steady.now().nanoseconds
+            t, q, w, dropped = samples.odometry_batch(
+                raws, lambda raw: deserialize_message(raw, Odometry), self._body_frame)
+            if dropped:
+                self._restarts['wrong_frame'] += dropped
+                self._warnings.warn('frame', f'{dropped} odom samples dropped: the twist is '
+                                    'in another frame than the body frame '
+                                    f'{self._body_frame!r} or the world frame')
+            norm = np.linalg.norm(q, axis=1)
+            good = np.isfinite(norm) & (norm >= 0.5) & np.all(np.isfinite(w), axis=1)
+            if not np.all(good):
+                self._restarts['non_finite'] += int(np.count_nonzero(~good))
+                self._warnings.warn('non-finite', 'odom sample with a non-finite or zero '
+                                    'quaternion or rate dropped')
+            q = q[good] / norm[good, None]
+            for sample in zip(t[good].tolist(), q, w[good]):
+                self._add_odom(*sample)
+        raws = self._intake.take('applied_torque')
+        if raws:
+            t, tau, dropped = samples.torque_batch(
+                raws, lambda raw: deserialize_message(raw, WrenchStamped), self._body_frame)
+            if dropped:
+                self._warnings.warn('torque frame', f'{dropped} applied torques dropped: not '
+                                    f'in the body frame {self._body_frame!r}')
+            for stamp, vec in zip(t.tolist(), tau.tolist()):
+                if all(math.isfinite(c) for c in vec):
+                    self._add_torque(stamp, vec)
+
+    def _add_odom(self, t, q, w):
+        """File one valid state sample (stamp t ns, unit q, body omega)."""
         s = self._settings
-        q = q / norm
         reason = self._buffer.add(t, q, w, int(s['reset_jump'] * 1e9), int(s['max_gap'] * 1e9))
         if reason:
             self._restarts[reason] += 1
@@ -268,14 +294,8 @@ class AttitudeAnalyzer(Node):
         if t >= self._baseline_floor and (self._baseline is None or t < self._baseline[0]):
             self._baseline = (t, q, w)
 
-    def _on_torque(self, msg):
-        try:
-            t, vec = samples.torque_sample(msg, self._body_frame)
-        except samples.FrameError as err:
-            self._warnings.warn('torque frame', f'applied torque dropped: {err}')
-            return
-        if not all(math.isfinite(c) for c in vec):
-            return
+    def _add_torque(self, t, vec):
+        """File one applied-torque sample (stamp t ns, body torque N m)."""
         self._buffer.add_torque(t, vec)
         # the torque-free segment (and so the baseline) starts at the first zero applied
         # torque after the last non-zero one: the state stamped there is past every torque
@@ -287,6 +307,11 @@ class AttitudeAnalyzer(Node):
         elif self._baseline_floor == _NEVER and t > self._last_torque:
             self._baseline_floor = t
             self._baseline = self._buffer.first_from(t)
+
+    def destroy_node(self):
+        """Destroy the intake helper node, then this one."""
+        self._intake.destroy()
+        return super().destroy_node()
 
     def _restart(self, why, floor=_ALWAYS):
         self._baseline = None
