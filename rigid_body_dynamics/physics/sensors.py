@@ -1,0 +1,145 @@
+"""
+A rate gyro with the error model calibration tools use, seeded and reproducible (no ROS).
+
+Model (per axis, body frame, samples at ``rate`` Hz, dt = 1 / rate):
+
+    omega_meas[k] = omega[k] + b[k] + n[k],    n[k] ~ N(0, N^2 / dt)
+    b[k + 1] = b[k] + K sqrt(dt) w[k]          (bias random walk, correlation_time 0)
+    b[k + 1] = phi b[k] + s w[k]               (Gauss-Markov, correlation_time tau > 0)
+    phi = exp(-dt / tau),  s = K sqrt(tau / 2 (1 - exp(-2 dt / tau))),  b[0] ~ N(0, bias0^2)
+
+N is the noise density (angle random walk, rad/s/sqrt(Hz)) and K the bias
+random walk (rate random walk, rad/s^2/sqrt(Hz)), as Kalibr and Allan-variance
+plots name them: the Allan deviation is N / sqrt(tau) for the white noise
+(read N at tau = 1 s) and K sqrt(tau / 3) for the walk. With a correlation
+time the bias is a first-order Gauss-Markov process whose short-term
+increments are those of the walk (s -> K sqrt(dt) for dt << tau) and whose
+stationary deviation is K sqrt(tau / 2) - Gazebo's ``dynamic_bias_stddev``
+plays the role of K there, which is why its bias wanders by
+``dynamic_bias_stddev * sqrt(tau / 2)``, not by ``dynamic_bias_stddev``.
+Conversions from Gazebo's per-sample ``stddev``: N = stddev * sqrt(dt); its
+turn-on ``bias_stddev`` is ``turn_on_bias`` here (Gazebo also draws a random
+sign around ``bias_mean``; not modelled). Orientation noise: a random rotation
+whose rotation vector is N(0, sigma^2) per axis, applied in the body frame.
+
+A perfect gyro (every parameter 0) returns the truth exactly and draws
+nothing. The same seed and parameters give the same stream, bit for bit,
+whether it is drawn sample by sample (:meth:`GyroModel.measure`) or in
+blocks (:meth:`GyroModel.sample`).
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+from . import quaternions
+
+
+@dataclass(frozen=True)
+class GyroErrors:
+    """
+    Error parameters of a gyro, all >= 0 and finite; 0 switches the term off.
+
+    ``noise_density`` N (rad/s/sqrt(Hz)); ``bias_random_walk`` K
+    (rad/s^2/sqrt(Hz)); ``turn_on_bias`` stddev of b[0] (rad/s);
+    ``correlation_time`` tau (s, 0 = a pure random walk); ``orientation_noise``
+    stddev (rad) of the rotation applied to the reported orientation.
+    """
+
+    noise_density: float = 0.0
+    bias_random_walk: float = 0.0
+    turn_on_bias: float = 0.0
+    correlation_time: float = 0.0
+    orientation_noise: float = 0.0
+
+    def __post_init__(self):
+        """Refuse negative or non-finite values, naming the parameter."""
+        for name in ('noise_density', 'bias_random_walk', 'turn_on_bias', 'correlation_time',
+                     'orientation_noise'):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0):
+                raise ValueError(f'{name} must be a finite number >= 0, got {value!r}')
+
+    @classmethod
+    def from_gazebo(cls, stddev, rate, bias_stddev=0.0, dynamic_bias_stddev=0.0,
+                    dynamic_bias_correlation_time=0.0):
+        """Convert Gazebo / SDFormat ``<noise>`` values (per sample) at ``rate`` Hz."""
+        return cls(noise_density=stddev / math.sqrt(rate), turn_on_bias=bias_stddev,
+                   bias_random_walk=dynamic_bias_stddev,
+                   correlation_time=dynamic_bias_correlation_time)
+
+
+class GyroModel:
+    """
+    A seeded gyro sampling at ``rate`` Hz with :class:`GyroErrors` ``errors``.
+
+    ``bias`` is the current true bias (rad/s, body frame, 3 axes), for
+    estimator evaluation.
+    """
+
+    def __init__(self, errors, rate, seed=0):
+        if not (rate > 0.0 and math.isfinite(rate)):
+            raise ValueError(f'rate must be positive and finite, got {rate!r}')
+        self.errors = errors
+        self.rate = float(rate)
+        self.dt = 1.0 / self.rate
+        self._rng = np.random.default_rng(seed)
+        self._white = errors.noise_density / math.sqrt(self.dt)
+        tau, k = errors.correlation_time, errors.bias_random_walk
+        if tau > 0.0:
+            self._phi = math.exp(-self.dt / tau)
+            self._walk = k * math.sqrt(0.5 * tau * -math.expm1(-2.0 * self.dt / tau))
+        else:
+            self._phi, self._walk = 1.0, k * math.sqrt(self.dt)
+        self.bias = (self._rng.standard_normal(3) * errors.turn_on_bias
+                     if errors.turn_on_bias else np.zeros(3))
+        self._perfect = not (self._white or self._walk)
+
+    @property
+    def rate_variance(self):
+        """Variance (rad/s)^2 of the white noise per sample: N^2 * rate (the Imu covariance)."""
+        return self._white ** 2
+
+    @property
+    def orientation_variance(self):
+        """Variance (rad^2) per axis of the orientation noise."""
+        return self.errors.orientation_noise ** 2
+
+    def measure(self, omega):
+        """Measure one sample: (measured rate, the bias in it), both (3,) rad/s, body frame."""
+        measured, bias = self.sample(np.asarray(omega, dtype=float).reshape(1, 3))
+        return measured[0], bias[0]
+
+    def sample(self, omega):
+        """
+        Measure consecutive true rates ``omega`` (N, 3) rad/s: returns (measured, bias) (N, 3).
+
+        Draws per sample first the white noise, then the bias increment (3 normals
+        each), so blocks and single samples give the same stream.
+        """
+        omega = np.asarray(omega, dtype=float).reshape(-1, 3)
+        n = omega.shape[0]
+        if self._perfect:       # no draws: the truth plus the constant turn-on bias (or 0)
+            bias = np.repeat(self.bias[None, :], n, axis=0)
+            return omega + bias, bias
+        draws = self._rng.standard_normal((n, 2, 3))
+        bias = np.empty((n, 3))
+        b = self.bias
+        phi, walk = self._phi, self._walk
+        for k in range(n):
+            bias[k] = b
+            b = phi * b + walk * draws[k, 1]
+        self.bias = b
+        return omega + bias + self._white * draws[:, 0], bias
+
+    def orientation(self, q):
+        """Return the attitude q (x, y, z, w) with the orientation noise applied (body frame)."""
+        sigma = self.errors.orientation_noise
+        if not sigma:
+            return np.asarray(q, dtype=float)
+        v = self._rng.standard_normal(3) * sigma
+        angle = float(np.linalg.norm(v))
+        axis = v / angle if angle > 0.0 else np.array([1.0, 0.0, 0.0])
+        return quaternions.multiply(np.asarray(q, dtype=float),
+                                    quaternions.from_axis_angle(axis, angle))
