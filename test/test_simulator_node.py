@@ -370,3 +370,42 @@ def test_thread_priority_is_applied_or_refused_with_the_reason(launch, probe):
     assert 'SCHED_FIFO at priority 10' in output
     assert (1, 10) in thread_policies(proc.proc.pid)   # one thread really runs under it
     stop_cleanly(proc)
+
+
+def test_noisy_gyro_stream_is_the_seeded_model_at_the_imu_stamps(launch, probe):
+    """
+    The imu topic carries the seeded gyro model's measurement, ~/imu_bias its true bias.
+
+    Gyro at 200 Hz (every 5th step), noise density 1e-3, bias random walk 1e-4, turn-on bias
+    1e-3, seed 42. The stream is a function of the sample index only, so the offline model fed
+    the exact torque-free rates at the same stamps reproduces every received sample (to the
+    1e-13 the exact flow and the simulator's rates differ by).
+    """
+    from sensor_msgs.msg import Imu
+    from rigid_body_dynamics.physics.sensors import GyroErrors, GyroModel
+    omega0 = (0.3, 1.5, -0.4)
+    proc = launch(SIM, '-p', 'publish_clock:=true', '-p', 'inertia:=[1.0, 2.0, 3.0]',
+                  '-p', 'initial_angular_velocity:=[0.3, 1.5, -0.4]', '-p', 'imu_rate:=200.0',
+                  '-p', 'gyro_noise_density:=0.001', '-p', 'gyro_bias_random_walk:=0.0001',
+                  '-p', 'gyro_turn_on_bias:=0.001', '-p', 'noise_seed:=42',
+                  '-p', 'real_time_factor:=2.0', name='sim')
+    imu = probe.subscribe(Imu, 'imu')
+    bias = probe.subscribe(Vector3Stamped, f'{NODE}/imu_bias')
+    probe.spin_until(lambda: len(imu) > 300 and len(bias) > 300, 30.0, '300 gyro samples')
+    index = np.array([time_ns(m.header.stamp) for m in imu]) // 5_000_000
+    assert np.all(np.array([time_ns(m.header.stamp) for m in imu]) % 5_000_000 == 0)
+    model = GyroModel(GyroErrors(1e-3, 1e-4, 1e-3), 200.0, seed=42)
+    stamps = np.arange(index.max() + 1) * 5e-3
+    _, w_true = FreeRigidBody((1.0, 2.0, 3.0), omega0).state_at(stamps)
+    expected, expected_bias = model.sample(w_true)
+    measured = np.array([vector_array(m.angular_velocity) for m in imu])
+    np.testing.assert_allclose(measured, expected[index], rtol=0, atol=1e-12)
+    assert np.max(np.abs(measured - w_true[index])) > 1e-3        # the noise is really there
+    b_index = np.array([time_ns(m.header.stamp) for m in bias]) // 5_000_000
+    np.testing.assert_array_equal(np.array([vector_array(m.vector) for m in bias]),
+                                  expected_bias[b_index])
+    cov = imu[-1].angular_velocity_covariance
+    assert [cov[0], cov[4], cov[8]] == pytest.approx([1e-6 * 200.0] * 3, rel=1e-14)  # N^2 rate
+    assert cov[1] == 0.0
+    assert imu[-1].linear_acceleration_covariance[0] == -1.0
+    stop_cleanly(proc)

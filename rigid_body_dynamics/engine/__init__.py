@@ -8,7 +8,7 @@ stepping on the steady clock). The nodes in ``nodes/`` are the ROS plumbing
 around them.
 """
 
-from .body import BodySimulation, Snapshot, TorqueCommand
+from .body import BodySimulation, ImuSample, Snapshot, TorqueCommand
 from .pacer import Pace
 
-__all__ = ['BodySimulation', 'Pace', 'Snapshot', 'TorqueCommand']
+__all__ = ['BodySimulation', 'ImuSample', 'Pace', 'Snapshot', 'TorqueCommand']

@@ -21,6 +21,7 @@ import threading
 import numpy as np
 
 from ..physics import make_integrator, quaternions
+from ..physics.sensors import GyroErrors, GyroModel
 
 _ZERO = (0.0, 0.0, 0.0)
 _NS = 1_000_000_000
@@ -37,6 +38,25 @@ class TorqueCommand:
     world: bool
     received_ns: int
     principal: object   # the body vector in the principal frame (None for a world command)
+
+
+@dataclass(frozen=True)
+class ImuSample:
+    """
+    One gyro sample, in the user's body frame.
+
+    ``stamp_ns``, the reported attitude ``q`` (x, y, z, w, body -> world, with
+    orientation noise), the measured rate ``omega`` (rad/s) and the true
+    ``bias`` (rad/s) in it, and the gyro's ``rate_variance`` (rad/s)^2 and
+    ``orientation_variance`` (rad^2) per axis.
+    """
+
+    stamp_ns: int
+    q: tuple
+    omega: tuple
+    bias: tuple
+    rate_variance: float
+    orientation_variance: float
 
 
 @dataclass(frozen=True)
@@ -64,14 +84,16 @@ class BodySimulation:
     ``inertia`` (Inertia), ``integrator`` (a name from INTEGRATORS), ``rate``
     (Hz; dt = 1 / rate), ``initial`` = (q0 x-y-z-w, omega0 rad/s) in the body
     frame, ``torque_timeout`` (s; 0 = hold forever), ``max_torque`` (N m per
-    axis; 0 = no limit), ``publish_every`` (steps per publish tick),
+    axis; 0 = no limit), ``publish_every`` (steps per publish tick), ``imu_every``
+    (steps per gyro sample, 0 = none), ``gyro`` (GyroErrors; None = perfect) and
+    its ``seed``,
     ``start_ns`` (stamp of simulated time 0). ``lock`` guards every change;
     the methods take it themselves. ``notes`` collects what a node should
     log (the watchdog's timeouts), drained with :meth:`take_notes`.
     """
 
     def __init__(self, inertia, integrator, rate, initial, torque_timeout=0.5, max_torque=0.0,
-                 publish_every=1, start_ns=0):
+                 publish_every=1, start_ns=0, imu_every=0, gyro=None, seed=0):
         self.lock = threading.RLock()
         self.rate = float(rate)
         self.dt = 1.0 / self.rate
@@ -83,6 +105,9 @@ class BodySimulation:
         self.timeout_ns = int(torque_timeout * _NS)
         self.max_torque = float(max_torque)
         self.publish_every = int(publish_every)
+        self.imu_every = int(imu_every)       # steps per gyro sample; 0 = no IMU
+        self.gyro_errors = gyro if gyro is not None else GyroErrors()
+        self.seed = int(seed)
         self.counts = dict.fromkeys(COUNTS, 0)
         self.notes = []
         self.reset()
@@ -101,6 +126,8 @@ class BodySimulation:
             self.command_held = None
             self.timed_out = False
             self.last_torque = _ZERO
+            self.gyro = GyroModel(self.gyro_errors, self.rate / max(self.imu_every, 1),
+                                  self.seed)     # same seed: the same stream after a reset
             self._baseline()
 
     def _baseline(self):
@@ -247,6 +274,25 @@ class BodySimulation:
         self.last_torque = torque
         if self.steps % self.publish_every == 0:
             outbox.append(self.snapshot())
+        if self.imu_every and self.steps % self.imu_every == 0:
+            outbox.append(self.imu_sample())
+
+    def first_items(self):
+        """Return the items of time 0 (call under ``lock``): the state, and an IMU sample."""
+        items = [self.snapshot()]
+        if self.imu_every:
+            items.append(self.imu_sample())
+        return items
+
+    def imu_sample(self):
+        """Sample the gyro at the current state (call under ``lock``): an :class:`ImuSample`."""
+        q_b, w_b = self.body_state()
+        measured, bias = self.gyro.measure(w_b)
+        gyro = self.gyro
+        return ImuSample(self.start_ns + int(self.steps * self.dt_ns),
+                         tuple(float(c) for c in gyro.orientation(q_b)),
+                         tuple(float(c) for c in measured), tuple(float(c) for c in bias),
+                         gyro.rate_variance, gyro.orientation_variance)
 
     def snapshot(self):
         """Take the current :class:`Snapshot` (call under ``lock``)."""

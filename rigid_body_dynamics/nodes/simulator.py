@@ -45,6 +45,7 @@ from ..engine import BodySimulation, Pace
 from ..engine.pacer import LATE_LIMIT
 from ..physics import Inertia, INTEGRATORS, presets
 from ..physics.integrators import REMOVED as REMOVED_INTEGRATORS
+from ..physics.sensors import GyroErrors
 
 NODE_NAME = 'attitude_simulator'
 _NS = 1_000_000_000
@@ -127,6 +128,13 @@ def _body(values, out):
         raise ConfigurationError(str(err)) from None
 
 
+def _imu_rate(values, out):
+    """Cross-check: imu_rate <= integration_rate."""
+    if out['imu_rate'] > out['integration_rate']:
+        raise ConfigurationError(f'imu_rate must be at most integration_rate '
+                                 f'({out["integration_rate"]:g} Hz), got {out["imu_rate"]:g}')
+
+
 def _publish_rate(values, out):
     """Cross-check: publish_rate <= integration_rate."""
     if out['publish_rate'] > out['integration_rate']:
@@ -188,8 +196,30 @@ PARAMETERS = ParameterTable([
           'rtprio limit (limits.conf); if refused, the node says so and runs normally.',
           low=0, high=99, read_only=True),
     Param('publish_imu', 'bool', True, 'true',
-          'Also publish sensor_msgs/Imu on imu (REP 145; no acceleration).', read_only=True),
-], cross_checks=(_body, _publish_rate))
+          'Also publish sensor_msgs/Imu on imu (REP 145; no acceleration) and the true gyro '
+          'bias on ~/imu_bias.', read_only=True),
+    Param('imu_rate', 'double', lambda node: float(node.get_parameter('publish_rate').value),
+          'publish_rate', 'Gyro samples per simulated second (Hz); at most integration_rate, '
+          'rounded to a whole number of steps.', low=1e-6, high=1e5, read_only=True),
+    Param('gyro_noise_density', 'double', 0.0, '0.0 rad/s/sqrt(Hz)',
+          'White rate noise N (angle random walk); its stddev per sample is N sqrt(imu_rate), '
+          'which is what Gazebo calls stddev.', low=0.0, high=1e3, read_only=True),
+    Param('gyro_bias_random_walk', 'double', 0.0, '0.0 rad/s^2/sqrt(Hz)',
+          'Bias random walk K (rate random walk): the bias moves by K sqrt(dt) per sample.',
+          low=0.0, high=1e3, read_only=True),
+    Param('gyro_turn_on_bias', 'double', 0.0, '0.0 rad/s',
+          'Standard deviation of the bias drawn at start and on ~/reset, per axis.',
+          low=0.0, high=1e3, read_only=True),
+    Param('gyro_bias_correlation_time', 'double', 0.0, '0.0 s',
+          'With tau > 0 the bias is Gauss-Markov (stationary deviation K sqrt(tau / 2), as '
+          'the dynamic bias of Gazebo); 0 = a random walk.', low=0.0, high=1e9, read_only=True),
+    Param('orientation_noise', 'double', 0.0, '0.0 rad',
+          'Standard deviation per axis of a random rotation applied to the imu orientation.',
+          low=0.0, high=3.0, read_only=True),
+    Param('noise_seed', 'int', 0, '0',
+          'Seed of the gyro noise: the same seed and parameters give the same imu stream, bit '
+          'for bit (also after ~/reset).', low=0, high=2 ** 31 - 1, read_only=True),
+], cross_checks=(_body, _publish_rate, _imu_rate))
 
 
 def _preset_name(name):
@@ -226,12 +256,20 @@ class AttitudeSimulator(Node):
             values['body'], values['integrator'], rate,
             (values['initial_orientation'], values['initial_angular_velocity']),
             values['torque_timeout'], values['max_torque'],
-            self._publish_every(values['publish_rate']), start_ns)
+            self._publish_every(values['publish_rate']), start_ns,
+            imu_every=self._publish_every(values['imu_rate']) if values['publish_imu'] else 0,
+            gyro=GyroErrors(values['gyro_noise_density'], values['gyro_bias_random_walk'],
+                            values['gyro_turn_on_bias'], values['gyro_bias_correlation_time'],
+                            values['orientation_noise']),
+            seed=values['noise_seed'])
         self._publish_rate = values['publish_rate']
         self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog)
         self._make_interfaces()
         self.state.publish_inertia(self.body.inertia, start_ns)
-        self.state.publish(self.body.snapshot())
+        with self.body.lock:
+            items = self.body.first_items()
+        for item in items:
+            self.state.publish(item)
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.add_post_set_parameters_callback(self._post_set_parameters)
         body = self.body.inertia
@@ -420,8 +458,9 @@ class AttitudeSimulator(Node):
         with self.body.lock:
             self.body.reset()
             self.pace.restart()
-            snapshot = self.body.snapshot()
-        self.state.publish(snapshot)
+            items = self.body.first_items()
+        for item in items:
+            self.state.publish(item)
         self.get_logger().info('reset to the initial state, simulated time 0')
         response.success = True
         response.message = 'reset to the initial state; simulated time restarts at 0'

@@ -4,7 +4,8 @@ StatePublisher: the state topics of one simulated body, as a helper that takes a
 Like tf2_ros' ``TransformBroadcaster(node)``: the node keeps its parameters,
 subscriptions and services; this object owns the publishers of ``odom``,
 ``orientation``, ``angular_velocity``, ``angular_momentum``,
-``angular_momentum_body``, ``applied_torque``, ``imu`` (optional), the latched
+``angular_momentum_body``, ``applied_torque``, ``imu`` and ``~/imu_bias``
+(optional; from the engine's gyro samples), the latched
 ``inertia`` and ``/clock`` (optional), and turns an engine
 :class:`~rigid_body_dynamics.engine.body.Snapshot` into their messages. All
 messages of one tick carry the snapshot's stamp; vectors are published in the
@@ -20,6 +21,7 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import Imu
 
 from . import conversions as conv
+from ..engine import ImuSample
 from ..physics import quaternions
 
 STATE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
@@ -48,12 +50,17 @@ class StatePublisher:
         self._l_body = pub(Vector3Stamped, 'angular_momentum_body')
         self._torque = pub(WrenchStamped, 'applied_torque')
         self._imu = pub(Imu, 'imu') if publish_imu else None
+        self._imu_bias = node.create_publisher(Vector3Stamped, '~/imu_bias', STATE_QOS) \
+            if publish_imu else None
         self._inertia = pub(InertiaStamped, 'inertia', LATCHED_QOS)
         self._clock = node.create_publisher(ClockMsg, '/clock', CLOCK_QOS) \
             if publish_clock else None
 
     def publish(self, snapshot):
-        """Publish the state topics of one tick from an engine Snapshot (principal frame)."""
+        """Publish one engine item: a Snapshot's state topics, or an ImuSample's imu and bias."""
+        if isinstance(snapshot, ImuSample):
+            self.publish_imu(snapshot)
+            return
         inertia = snapshot.inertia
         q_p, w_p = snapshot.q, snapshot.omega
         stamp = conv.time_msg(snapshot.stamp_ns)
@@ -84,13 +91,32 @@ class StatePublisher:
         wrench.header.stamp, wrench.header.frame_id = stamp, body_frame
         wrench.wrench.torque = conv.vector_msg(tau_b)
         self._torque.publish(wrench)
-        if self._imu is not None:
-            imu = Imu(orientation=q_msg, angular_velocity=w_msg)
-            imu.header.stamp, imu.header.frame_id = stamp, body_frame
-            imu.linear_acceleration_covariance[0] = -1.0
-            self._imu.publish(imu)
         if self._clock is not None:
             self._clock.publish(ClockMsg(clock=stamp))
+
+    def publish_imu(self, sample):
+        """
+        Publish sensor_msgs/Imu (REP 145) and ~/imu_bias from an engine ImuSample.
+
+        Covariances: angular velocity N^2 * rate on the diagonal (the white noise
+        per sample; the bias is published apart on ~/imu_bias), orientation the
+        orientation noise variance; linear acceleration -1 in element 0 (not
+        simulated, as sensor_msgs/Imu says).
+        """
+        if self._imu is None:
+            return
+        stamp = conv.time_msg(sample.stamp_ns)
+        imu = Imu(orientation=conv.quaternion_msg(sample.q),
+                  angular_velocity=conv.vector_msg(sample.omega))
+        imu.header.stamp, imu.header.frame_id = stamp, self.body_frame
+        for i in (0, 4, 8):
+            imu.angular_velocity_covariance[i] = sample.rate_variance
+            imu.orientation_covariance[i] = sample.orientation_variance
+        imu.linear_acceleration_covariance[0] = -1.0
+        self._imu.publish(imu)
+        bias = Vector3Stamped(vector=conv.vector_msg(sample.bias))
+        bias.header.stamp, bias.header.frame_id = stamp, self.body_frame
+        self._imu_bias.publish(bias)
 
     def publish_inertia(self, inertia, stamp_ns):
         """Publish the latched inertia tensor (kg m^2, body frame; the mass is not modelled)."""
