@@ -29,7 +29,7 @@ import numpy as np
 
 from .bags import BagError, BagWriter, INERTIA, ODOMETRY, read_trajectory, WRENCH
 from .physics import estimators, INTEGRATORS, presets, quaternions, simulate
-from .physics.analysis import analyse, drift_series, Trajectory
+from .physics.analysis import analyse, Trajectory
 
 
 def offline_run(preset, integrator, duration, dt, progress=None):
@@ -166,7 +166,7 @@ def make_report(run, out_dir):
     found = analyse(run)
     floor = np.finfo(float).eps
     drift = dict(zip(('|T/T0 - 1|', '||L|/|L0| - 1|', 'angle(L, L0) (rad)'),
-                     drift_series(moments, q, w, q[0], w[0])))
+                     estimators.drift_series(moments, q, w, q[0], w[0])))
     fig, ax = _figure('Conservation: drift from the first sample (log scale; floor = eps)',
                       'time (s)', 'relative drift')
     for label, values in drift.items():

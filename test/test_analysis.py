@@ -122,8 +122,8 @@ def test_short_window_asymmetric_precession_is_unavailable_with_theory():
     run = simulate(body.moments, body.omega0, body.q0, duration=5.0, dt=1e-2)
     p = analyse(Trajectory.from_simulation(run)).precession
     assert p.status == UNAVAILABLE and 'shorter than a period' in p.message
-    assert p.omega_period.theory == pytest.approx(
-        theory.omega_period(body.moments, body.omega0), rel=1e-11)   # near the separatrix
+    # the theory of the window's newest state (near the separatrix the period is sensitive)
+    assert p.omega_period.theory == theory.omega_period(body.moments, run.omega[-1])
 
 
 def test_json_form_has_the_documented_keys():

@@ -86,8 +86,7 @@ class BodySimulation:
     frame, ``torque_timeout`` (s; 0 = hold forever), ``max_torque`` (N m per
     axis; 0 = no limit), ``publish_every`` (steps per publish tick), ``imu_every``
     (steps per gyro sample, 0 = none), ``gyro`` (GyroErrors; None = perfect) and
-    its ``seed``,
-    ``start_ns`` (stamp of simulated time 0). ``lock`` guards every change;
+    its ``seed``, ``start_ns`` (stamp of simulated time 0). ``lock`` guards every change;
     the methods take it themselves. ``notes`` collects what a node should
     log (the watchdog's timeouts), drained with :meth:`take_notes`.
     """
@@ -312,10 +311,8 @@ class BodySimulation:
         """
         with self.lock:
             s = self.stepper
-            if self._base_stale:      # under torque: drift since the latest torque step
-                self._baseline()
-                self._base_stale = True
-            t0, l0 = self.base
+            # under torque the baseline is the state after the latest torque step: this one
+            t0, l0 = self.invariants() if self._base_stale else self.base
             t1, l1 = self.invariants()
             g0 = math.sqrt(sum(c * c for c in l0))
             g1 = math.sqrt(sum(c * c for c in l1))

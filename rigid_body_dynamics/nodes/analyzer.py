@@ -188,7 +188,8 @@ class AttitudeAnalyzer(Node):
         self._last_torque = _ALWAYS            # ns: stamp of the newest non-zero torque
         self._body_frame = None                # frame id of the inertia, when known
         self._topic_inertia = (None, None)     # the latched topic's (Inertia, frame id)
-        self._restarts = {'reset': 0, 'gap': 0, 'non_finite': 0, 'wrong_frame': 0}
+        # restarts (a time reset, a gap) and dropped samples (non-finite or zero q, wrong frame)
+        self._counts = {'reset': 0, 'gap': 0, 'non_finite': 0, 'wrong_frame': 0}
         self._received = 0
         self._last_arrival = None
         self._rate_window = []
@@ -258,14 +259,14 @@ class AttitudeAnalyzer(Node):
             t, q, w, dropped = samples.odometry_batch(
                 raws, lambda raw: deserialize_message(raw, Odometry), self._body_frame)
             if dropped:
-                self._restarts['wrong_frame'] += dropped
+                self._counts['wrong_frame'] += dropped
                 self._warnings.warn('frame', f'{dropped} odom samples dropped: the twist is '
                                     'in another frame than the body frame '
                                     f'{self._body_frame!r} or the world frame')
             norm = np.linalg.norm(q, axis=1)
             good = np.isfinite(norm) & (norm >= 0.5) & np.all(np.isfinite(w), axis=1)
             if not np.all(good):
-                self._restarts['non_finite'] += int(np.count_nonzero(~good))
+                self._counts['non_finite'] += int(np.count_nonzero(~good))
                 self._warnings.warn('non-finite', 'odom sample with a non-finite or zero '
                                     'quaternion or rate dropped')
             q = q[good] / norm[good, None]
@@ -287,7 +288,7 @@ class AttitudeAnalyzer(Node):
         s = self._settings
         reason = self._buffer.add(t, q, w, int(s['reset_jump'] * 1e9), int(s['max_gap'] * 1e9))
         if reason:
-            self._restarts[reason] += 1
+            self._counts[reason] += 1
             self._restart(f'{"time went backwards" if reason == "reset" else "gap in stamps"} '
                           f'at t = {t * 1e-9:.6f} s')
         # the baseline is the earliest sample (by stamp) of the torque-free segment
@@ -382,10 +383,10 @@ class AttitudeAnalyzer(Node):
         (t0, n0), (t1, n1) = self._rate_window[0], self._rate_window[-1]
         rate = (n1 - n0) / ((t1 - t0) * 1e-9) if t1 > t0 else math.nan
         values = [('messages received', self._received), ('rate (Hz)', rate),
-                  ('restarts after a time reset', self._restarts['reset']),
-                  ('restarts after a gap', self._restarts['gap']),
-                  ('dropped non-finite samples', self._restarts['non_finite']),
-                  ('dropped samples in another frame', self._restarts['wrong_frame']),
+                  ('restarts after a time reset', self._counts['reset']),
+                  ('restarts after a gap', self._counts['gap']),
+                  ('dropped non-finite samples', self._counts['non_finite']),
+                  ('dropped samples in another frame', self._counts['wrong_frame']),
                   ('inertia source', self._inertia_source or 'none'),
                   ('body frame', self._body_frame or 'any'),
                   ('samples in the window', len(self._buffer.t))]

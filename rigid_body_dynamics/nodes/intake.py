@@ -41,10 +41,6 @@ class Intake:
                 out.append(taken[0])
         return out
 
-    def publisher_count(self, topic):
-        """Return how many publishers the subscription of ``topic`` is matched with."""
-        return self._subs[topic].get_publisher_count()
-
     def destroy(self):
         """Destroy the helper node (before the owner's context shuts down)."""
         self.node.destroy_node()

@@ -15,13 +15,12 @@ frame; omega (rad/s) and torque (N m) are in that body frame. Axis indices in
 the findings are 0-based body axes (the JSON form adds 1).
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 import math
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
-from . import equations, estimators, quaternions, theory
+from . import equations, estimators, theory
 from .inertia import as_inertia
 
 OK, WARN, ERROR, UNAVAILABLE = 'OK', 'WARN', 'ERROR', 'unavailable'
@@ -289,7 +288,6 @@ class Findings:
     kinetic_energy: object = None
     angular_momentum_norm: object = None
     under_torque: bool = False
-    notes: list = field(default_factory=list)
 
     def to_dict(self):
         """Return the JSON form (``rigid_body_analyze --json``): numbers, None where n/a."""
@@ -394,13 +392,14 @@ def analyse(trajectory, baseline=None, tolerances=Tolerances()):
     moments, q, w, tau = trajectory.principal()
     t = trajectory.t
     under_torque = bool(np.any(tau != 0.0))
-    if baseline is not None:
+    if baseline is None:
+        baseline = (int(trajectory.t_ns[0]), q[0], w[0])
+    else:
         b_t, b_q, b_w = baseline
-        b_q = trajectory.inertia.attitude_to_principal(np.asarray(b_q, dtype=float))
-        b_w = trajectory.inertia.to_principal(np.asarray(b_w, dtype=float))
-        baseline = (int(b_t), b_q, b_w)
-    conservation = _conservation(t, q, w, tau, moments, baseline, under_torque, tol,
-                                 trajectory.t_ns[0])
+        baseline = (int(b_t),
+                    trajectory.inertia.attitude_to_principal(np.asarray(b_q, dtype=float)),
+                    trajectory.inertia.to_principal(np.asarray(b_w, dtype=float)))
+    conservation = _conservation(t, q, w, tau, moments, baseline, under_torque, tol)
     if under_torque:
         why = 'torque applied in the window: the free-motion theory does not apply'
         precession = PrecessionFindings(UNAVAILABLE, why, UNAVAILABLE)
@@ -414,7 +413,7 @@ def analyse(trajectory, baseline=None, tolerances=Tolerances()):
                     under_torque=under_torque)
 
 
-def _conservation(t, q, w, tau, moments, baseline, under_torque, tol, first_ns):
+def _conservation(t, q, w, tau, moments, baseline, under_torque, tol):
     if under_torque:
         bal = estimators.balance(t, q, w, tau, moments)
         worst = max(bal.energy, bal.momentum) / tol.balance if tol.balance else 0.0
@@ -425,10 +424,8 @@ def _conservation(t, q, w, tau, moments, baseline, under_torque, tol, first_ns):
         return ConservationFindings(level, message, 'balance laws', energy_residual=bal.energy,
                                     momentum_residual=bal.momentum, work=bal.work,
                                     energy_tolerance=tol.balance, momentum_tolerance=tol.balance)
-    if baseline is None:
-        baseline = (int(first_ns), q[0], w[0])
     b_t, b_q, b_w = baseline
-    energy, norm, direction = drift_series(moments, q, w, b_q, b_w)
+    energy, norm, direction = estimators.drift_series(moments, q, w, b_q, b_w)
     e_err, l_err, d_err = float(energy.max()), float(norm.max()), float(direction.max())
     worst_e = e_err / tol.energy if tol.energy else 0.0
     worst_l = max(l_err, d_err) / tol.momentum if tol.momentum else 0.0
@@ -439,24 +436,6 @@ def _conservation(t, q, w, tau, moments, baseline, under_torque, tol, first_ns):
         'tolerance')
     return ConservationFindings(level, message, 'free motion', e_err, l_err, d_err, int(b_t),
                                 energy_tolerance=tol.energy, momentum_tolerance=tol.momentum)
-
-
-def drift_series(moments, q, omega, q0, omega0):
-    """
-    Free-motion drift of each sample from the baseline (q0, omega0), principal frame.
-
-    Returns arrays (N,): |T/T0 - 1|, ||L|/|L0| - 1| and the angle (rad)
-    between L_w and L_w0 (zeros where the baseline has no energy or momentum).
-    """
-    e0 = float(equations.kinetic_energy(moments, omega0))
-    l0 = equations.angular_momentum_world(moments, q0, omega0)
-    lw = equations.angular_momentum_world(moments, q, omega)
-    g0 = float(np.linalg.norm(l0))
-    zeros = np.zeros(len(omega))
-    energy = np.abs(equations.kinetic_energy(moments, omega) / e0 - 1.0) if e0 else zeros
-    norm = np.abs(np.linalg.norm(lw, axis=1) / g0 - 1.0) if g0 else zeros
-    direction = estimators.vector_angle(lw, l0) if g0 else zeros
-    return energy, norm, direction
 
 
 def _precession(t, q, w, moments, inertia, tol):
@@ -490,21 +469,6 @@ def _precession(t, q, w, moments, inertia, tol):
                               cones=cones, symmetry_axis=axis, polhode_family='symmetric')
 
 
-def _mean_rate_over_periods(t, angle, period):
-    """
-    Mean rate (rad/s) of an unwrapped angle over the largest whole number of periods.
-
-    Over a whole number n of periods a periodic modulation cancels; the angle
-    at the window's end and n periods before comes from a cubic spline of the
-    samples (the ends need not be samples). Returns (rate, n).
-    """
-    n = int(math.floor((t[-1] - t[0]) / period))
-    phi = np.unwrap(angle)
-    spline = CubicSpline(t, phi)
-    start = t[-1] - n * period
-    return float((phi[-1] - spline(start)) / (n * period)), n
-
-
 def _asymmetric_precession(t, q, w, moments, tol):
     period = theory.omega_period(moments, w[-1])
     pol = theory.polhode(moments, w[-1])
@@ -530,10 +494,8 @@ def _asymmetric_precession(t, q, w, moments, tol):
         omega_period = compare(estimators.crossing_period(t, w[:, mid], 0), period, tol.rate, 's')
     except ValueError as err:
         omega_period = unavailable(str(err), period, 's')
-    lw = equations.angular_momentum_world(moments, q, w)
-    u, v, _ = estimators.basis_perpendicular(lw.mean(axis=0))
-    e = quaternions.rotate(q, np.eye(3)[axis])
-    rate, periods = _mean_rate_over_periods(t, np.arctan2(e @ v, e @ u), period)
+    rate, periods = estimators.mean_rate_over_periods(
+        t, estimators.lab_precession_angle(q, w, moments, axis), period)
     mean = compare(rate, mean_theory, tol.rate, 'rad/s')
     status = _worst(omega_period.status, mean.status)
     measured = 'n/a' if omega_period.measured is None else f'{omega_period.measured:.6g}'

@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
+from scipy.interpolate import CubicSpline
 
 from . import equations, quaternions
 
@@ -95,10 +96,37 @@ def lab_precession_rate(t, q, omega, moments, axis=2):
     the principal moments in the body-axis order (kg m^2).
     """
     t, q, w = sort_samples(t, q, omega)
-    lw = equations.angular_momentum_world(moments, q, w)
+    return angle_rate(t, lab_precession_angle(q, w, moments, axis))
+
+
+def lab_precession_angle(q, omega, moments, axis=2):
+    """
+    Azimuth (rad, wrapped) of body axis ``axis`` about the mean world angular momentum.
+
+    R(q) e_axis projected on a fixed basis perpendicular to the mean of
+    L_w = R(q) I omega, per sample (in the given order; unwrap it yourself).
+    """
+    lw = equations.angular_momentum_world(moments, q, omega)
     u, v, _ = basis_perpendicular(lw.mean(axis=0))
     e = quaternions.rotate(q, np.eye(3)[axis])
-    return angle_rate(t, np.arctan2(e @ v, e @ u))
+    return np.arctan2(e @ v, e @ u)
+
+
+def mean_rate_over_periods(t, angle, period):
+    """
+    Mean rate (rad/s) of an angle over the largest whole number of ``period`` s that fits.
+
+    Over a whole number n of periods a periodic modulation of the rate cancels
+    (a least-squares slope over a window that is not would keep part of it);
+    the angle n periods before the last sample comes from a cubic spline of
+    the unwrapped samples. ``t`` sorted (s). Returns (rate, n); n >= 1 needed.
+    """
+    n = int(math.floor((t[-1] - t[0]) / period))
+    if n < 1:
+        raise ValueError('the samples span less than one period')
+    phi = np.unwrap(angle)
+    start = t[-1] - n * period
+    return float((phi[-1] - CubicSpline(t, phi)(start)) / (n * period)), n
 
 
 @dataclass(frozen=True)
@@ -121,16 +149,30 @@ def vector_angle(a, b):
     return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1))
 
 
+def drift_series(moments, q, omega, q0, omega0):
+    """
+    Free-motion drift of each sample from the baseline (q0, omega0), principal frame.
+
+    Returns arrays (N,): |T/T0 - 1|, ||L|/|L0| - 1| and the angle (rad)
+    between L_w and L_w0 (zeros where the baseline has no energy or momentum).
+    """
+    e0 = float(equations.kinetic_energy(moments, omega0))
+    l0 = equations.angular_momentum_world(moments, q0, omega0)
+    lw = equations.angular_momentum_world(moments, q, omega)
+    g0 = float(np.linalg.norm(l0))
+    zeros = np.zeros(len(omega))
+    energy = np.abs(equations.kinetic_energy(moments, omega) / e0 - 1.0) if e0 else zeros
+    norm = np.abs(np.linalg.norm(lw, axis=-1) / g0 - 1.0) if g0 else zeros
+    direction = vector_angle(lw, l0) if g0 else zeros
+    return energy, norm, direction
+
+
 def conservation(t, q, omega, moments):
-    """Measure the drift of T, |L| and the direction of L_w from sampled states."""
+    """Measure the drift of T, |L| and the direction of L_w from the first sample by stamp."""
     t, q, w = sort_samples(t, q, omega)
-    energy = equations.kinetic_energy(moments, w)
-    lw = equations.angular_momentum_world(moments, q, w)
-    norm = np.linalg.norm(lw, axis=-1)
-    return Conservation(
-        energy=float(np.max(np.abs(energy - energy[0])) / energy[0]),
-        momentum=float(np.max(np.abs(norm - norm[0])) / norm[0]),
-        direction=float(np.max(vector_angle(lw, lw[0]))))
+    energy, norm, direction = drift_series(moments, q, w, q[0], w[0])
+    return Conservation(energy=float(energy.max()), momentum=float(norm.max()),
+                        direction=float(direction.max()))
 
 
 @dataclass(frozen=True)

@@ -83,8 +83,8 @@ class Integrator(ABC):
     """
     Protocol: a fixed-step stepper for one body, state in the principal frame.
 
-    ``moments`` (kg m^2, body-axis order), ``dt`` (s), initial ``q0`` (x, y,
-    z, w; body -> world) and ``omega0`` (rad/s, body). After :meth:`step`:
+    ``moments`` (principal, kg m^2), ``dt`` (s), initial ``q0`` (x, y, z, w;
+    principal frame -> world) and ``omega0`` (rad/s, principal frame). After :meth:`step`:
     ``q``, ``omega`` (tuples), ``steps`` (int), ``time`` = steps * dt (s),
     ``work`` (J) and ``impulse`` (world, N m s) since the last :meth:`reset`.
 
@@ -208,6 +208,10 @@ class RK4Integrator(Integrator):
         return work
 
 
+#: Marks a torque-free segment stepped by RK (near the separatrix) in ExactIntegrator.
+_RK_SEGMENT = object()
+
+
 class ExactIntegrator(Integrator):
     """
     Exact free flow; under torque, an explicit Runge-Kutta step of order 6 or 8.
@@ -243,6 +247,8 @@ class ExactIntegrator(Integrator):
             self._shape = BodyShape(self.moments)
             self._i_min = min(self.moments)
             self._order6_rate = self.ORDER6_LIMIT / self.dt   # rho (1/s) up to which order 6
+        # the torque-free segment: None (starts at the next free step), (flow, start step),
+        # or _RK_SEGMENT near the separatrix (free motion keeps S, so it stays near it)
         self._segment = None
         self._torque_key = None        # the torque whose time scale is cached below
         self._torque_rate = 0.0        # sqrt(max |tau_i| / I_min), 1/s
@@ -250,11 +256,9 @@ class ExactIntegrator(Integrator):
     def _free_step(self):
         if self._segment is None:
             flow = self._shape.flow(self.q, self.angular_momentum_body)
-            self._segment = None if flow.near_separatrix else (flow, self.steps)
-        if self._segment is None:
-            self._torque_rate = 0.0
-            self._torque_key = None
-            self._rk('free', None, None)
+            self._segment = _RK_SEGMENT if flow.near_separatrix else (flow, self.steps)
+        if self._segment is _RK_SEGMENT:
+            self._rk('free', None, None, 0.0)
             return
         flow, start = self._segment
         q, m = flow.state((self.steps + 1 - start) * self.dt)
@@ -273,17 +277,22 @@ class ExactIntegrator(Integrator):
                                abs(torque_world[2]))
             self._torque_rate = math.sqrt(largest / self._i_min)
             self._torque_key = key
-        return self._rk('body' if torque_world is None else 'world', torque, torque_world)
+        return self._rk('body' if torque_world is None else 'world', torque, torque_world,
+                        self._torque_rate)
 
-    def _rk(self, mode, torque, torque_world):
-        """Advance by dt with the order-6 or order-8 kernel of ``mode``; return the work (J)."""
+    def _rk(self, mode, torque, torque_world, torque_rate):
+        """
+        Advance by dt with the order-6 or order-8 kernel of ``mode``; return the work (J).
+
+        ``torque_rate`` (1/s) is the torque's part of rho, sqrt(max |tau_i| / I_min).
+        """
         wx, wy, wz = self.omega
-        spare = self._order6_rate - self._torque_rate     # what |omega| may be for order 6
+        spare = self._order6_rate - torque_rate     # what |omega| may be for order 6
         if spare > 0.0 and wx * wx + wy * wy + wz * wz <= spare * spare:
             self.q, self.omega, work = self._kernels[mode][0](
                 self._inv, self.q, self.omega, self.dt, torque, torque_world)
             return work
-        rho = math.sqrt(wx * wx + wy * wy + wz * wz) + self._torque_rate
+        rho = math.sqrt(wx * wx + wy * wy + wz * wz) + torque_rate
         n = max(1, math.ceil(rho * self.dt / self.ORDER8_LIMIT))
         h = self.dt / n
         order8 = self._kernels[mode][1]

@@ -62,7 +62,8 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     (rad/s) and ``torque`` in the body frame of ``inertia``; ``q0`` (x, y, z,
     w) body -> world. ``torque`` is None (free), a constant 3-vector (N m) or
     a callable ``torque(t, q, omega)`` -> 3-vector evaluated at the start of
-    each step and held over it. ``integrator`` is a name from INTEGRATORS.
+    each step and held over it (the last row repeats the last torque).
+    ``integrator`` is a name from INTEGRATORS.
     ``every``: keep every n-th step. ``progress(fraction)``, if given, is
     called about a hundred times as the run goes (for long runs). Returns a
     :class:`SimulationResult` including t = 0.
@@ -86,10 +87,11 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     t, q, w, tau, work, imp = [], [], [], [], [], []
     step = stepper.step
     for k in range(n + 1):
-        if callable(torque):
+        if callable(torque) and (k < n or k == 0):
+            # (the last row repeats the last torque: no step starts there)
             tb = user_torque(stepper.time, *_user_state(inertia, stepper))
             tp = _principal(inertia, tb, stepper.time)
-        else:
+        elif not callable(torque):
             tb, tp = body_const, principal_const
         if k % every == 0:
             t.append(stepper.time)
@@ -99,7 +101,10 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
             work.append(stepper.work)
             imp.append(stepper.impulse)
         if k < n:
-            step(tp)
+            try:
+                step(tp)
+            except ValueError as err:     # the integrator refuses a non-finite torque
+                raise ValueError(f'torque at t={stepper.time!r} s: {err}') from None
         if progress is not None and (k % report_every == 0 or k == n):
             progress(k / max(n, 1))
     tau = np.array(tau, dtype=float).reshape(-1, 3)
@@ -110,14 +115,12 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
 
 
 def _principal(inertia, torque_body, t):
-    """Return a user's body torque (N m) as a principal-frame tuple; ValueError if bad."""
+    """Return a user's body torque (N m) as a principal-frame tuple; ValueError if not 3."""
     try:
         values = tuple(float(c) for c in np.asarray(torque_body, dtype=float).reshape(3))
     except (TypeError, ValueError):
         raise ValueError(f'torque(t={t!r}) must return three numbers (N m), '
                          f'got {torque_body!r}') from None
-    if not all(math.isfinite(c) for c in values):
-        raise ValueError(f'torque(t={t!r}) returned a non-finite torque {values}')
     if inertia.is_principal_frame:
         return values
     return tuple(float(c) for c in inertia.to_principal(np.array(values)))
