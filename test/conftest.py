@@ -79,18 +79,37 @@ def probe():
 @pytest.fixture
 def launch(tmp_path):
     """
-    Start node processes: call the fixture with a module, ros args and a name.
+    Start node processes: call the fixture with a module, ros args, a name (and env additions).
 
     Every process still running at the end of the test is stopped with SIGINT.
     """
     from ros_harness import NodeProcess
     started = []
 
-    def start(module, *ros_args, name='node'):
-        proc = NodeProcess(module, ros_args, log_dir=str(tmp_path), name=name)
+    def start(module, *ros_args, name='node', env=None):
+        proc = NodeProcess(module, ros_args, log_dir=str(tmp_path), name=name, env=env)
         started.append(proc)
         return proc
     yield start
     for proc in started:
         if proc.proc.poll() is None:
             proc.stop()
+
+
+@pytest.fixture(scope='session')
+def tf2_msgs_env():
+    """
+    Build the tf2_msgs interface once per venv (test/tf2_msgs_build.py); its environment.
+
+    Returns the variables a process needs to import it. Where it cannot be
+    built the test is skipped with the reason, unless RBD_REQUIRE_TF2_MSGS is
+    set (.ci/run sets it: CI must build it).
+    """
+    import tf2_msgs_build
+    try:
+        prefix = tf2_msgs_build.build()
+    except (tf2_msgs_build.BuildError, OSError) as err:
+        if os.environ.get('RBD_REQUIRE_TF2_MSGS'):
+            pytest.fail(f'tf2_msgs interface could not be built: {err}')
+        pytest.skip(f'tf2_msgs interface could not be built here: {err}')
+    return tf2_msgs_build.environment(prefix)

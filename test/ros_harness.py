@@ -132,10 +132,11 @@ def command_round_trips(probe, rounds, period):
 class NodeProcess:
     """A node started as its own process; ``stop()`` sends SIGINT and returns the exit code."""
 
-    def __init__(self, module, ros_args=(), log_dir=None, name='node'):
+    def __init__(self, module, ros_args=(), log_dir=None, name='node', env=None):
         self.log_path = os.path.join(log_dir or os.environ['ROS_LOG_DIR'], f'{name}.log')
         self._log = open(self.log_path, 'w')
-        self.proc = start_node(module, ros_args, stdout=self._log, stderr=subprocess.STDOUT)
+        self.proc = start_node(module, ros_args, stdout=self._log, stderr=subprocess.STDOUT,
+                               env=dict(os.environ, **(env or {})))
 
     def output(self):
         """Everything the process printed so far."""

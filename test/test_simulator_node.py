@@ -409,3 +409,52 @@ def test_noisy_gyro_stream_is_the_seeded_model_at_the_imu_stamps(launch, probe):
     assert cov[1] == 0.0
     assert imu[-1].linear_acceleration_covariance[0] == -1.0
     stop_cleanly(proc)
+
+
+def test_tf_is_broadcast_with_the_odom_stamp_and_frames(launch, tf2_msgs_env):
+    """
+    /tf carries odom -> base_link at every odom stamp, the odom orientation, no translation.
+
+    Simulator and listener run with the tf2_msgs interface built from its definition
+    (test/tf2_msgs_build.py); the /tf publisher's type hash is Jazzy's, so a ROS install's
+    tf2 listeners and RViz accept it; tf2_ros' broadcaster QoS (reliable, volatile).
+    """
+    import json
+    import subprocess
+    import sys
+    import tf2_msgs_build
+    env = dict(os.environ, **tf2_msgs_env)
+    proc = launch(SIM, '-p', 'publish_clock:=true', '-p', 'inertia:=[1.0, 2.0, 3.0]',
+                  '-p', 'initial_angular_velocity:=[0.3, 1.5, -0.4]',
+                  '-p', 'real_time_factor:=2.0', name='sim_tf', env=tf2_msgs_env)
+    listener = subprocess.run(
+        [sys.executable, os.path.join(os.path.dirname(__file__), 'tf_listener.py'),
+         '--count', '100'], env=env, capture_output=True, text=True, timeout=90)
+    assert listener.returncode == 0, listener.stderr[-3000:]
+    got = json.loads(listener.stdout)
+    odom = dict(got['odom'])                         # stamp -> quaternion
+    assert all(len(m) == 1 for m in got['tf'])
+    transforms = [m[0] for m in got['tf']]
+    matched = [t for t in transforms if t[0] in odom]
+    assert len(matched) >= 90                        # each TF has an odom at its very stamp
+    for t, parent, child, translation, rotation in transforms:
+        assert (parent, child) == ('odom', 'base_link')
+        assert translation == [0.0, 0.0, 0.0]
+        if t in odom:
+            assert rotation == odom[t]               # the same quaternion, bit for bit
+    stamps = [t[0] for t in transforms]
+    assert stamps == sorted(stamps) and len(set(np.diff(stamps))) == 1   # every 10 ms tick
+    assert got['publishers'] == [['attitude_simulator', 'tf2_msgs/msg/TFMessage',
+                                  tf2_msgs_build.JAZZY_TYPE_HASH, 'RELIABLE', 'VOLATILE']]
+    assert 'tf2_msgs is not importable' not in proc.output()
+    stop_cleanly(proc)
+
+
+def test_without_tf2_msgs_the_simulator_says_so_and_runs(launch, probe):
+    """Where tf2_msgs cannot be imported (pip-only), no /tf publisher and one info line."""
+    proc = launch(SIM, '-p', 'real_time_factor:=2.0', name='sim_no_tf')
+    probe.subscribe(Odometry, 'odom')
+    probe.wait_for('odom', 5)                       # running: the state topics are there
+    assert probe.node.get_publishers_info_by_topic('/tf') == []
+    assert 'tf2_msgs is not importable' in proc.output()
+    stop_cleanly(proc)

@@ -88,6 +88,7 @@ class Fleet:
             for node in self.nodes:
                 node.destroy_node()
             raise
+        self._untangle_tf()
         self.context = self.nodes[0].context     # one context, shared by every body
         # Each executor wake-up rebuilds the wait set of every body (about 0.3 ms
         # per body, holding the GIL), so the bodies have no diagnostics timers of
@@ -100,6 +101,21 @@ class Fleet:
             f'{len(self.nodes)} bodies in this process ({", ".join(names[:5])}'
             f'{", ..." if len(names) > 5 else ""}), '
             f'{"one shared integration thread" if shared else "one integration thread each"}')
+
+    def _untangle_tf(self):
+        """Stop /tf for bodies whose (world, body) frames another body also broadcasts."""
+        frames = collections.Counter(
+            n.state.world_frame + ' -> ' + n.state.body_frame
+            for n in self.nodes if n.state.broadcasts_tf)
+        shared = [n for n in self.nodes
+                  if frames[n.state.world_frame + ' -> ' + n.state.body_frame] > 1]
+        for node in shared:
+            node.state.stop_tf(node)
+        if shared:
+            self._logger.warning(
+                f'{len(shared)} bodies have the same frames ({", ".join(sorted(frames))}): '
+                'they do not broadcast /tf, which would mix them; give each its own body_frame '
+                '(key /<name>/attitude_simulator) to get TF')
 
     def _publish_diagnostics(self):
         for node in self.nodes:

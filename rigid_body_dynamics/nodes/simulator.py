@@ -39,7 +39,7 @@ from std_srvs.srv import SetBool, Trigger
 from . import conversions as conv
 from .parameters import as_vector, ConfigurationError, Param, ParameterTable
 from .runner import run
-from .state_publisher import STATE_QOS, StatePublisher
+from .state_publisher import STATE_QOS, StatePublisher, tf_available
 from .throttle import ThrottledWarnings
 from ..engine import BodySimulation, Pace
 from ..engine.pacer import LATE_LIMIT
@@ -195,6 +195,10 @@ PARAMETERS = ParameterTable([
           'deadlines on a loaded machine; 0 = normal scheduling. Needs CAP_SYS_NICE or an '
           'rtprio limit (limits.conf); if refused, the node says so and runs normally.',
           low=0, high=99, read_only=True),
+    Param('publish_tf', 'bool', True, 'true',
+          'Broadcast world_frame -> body_frame on /tf (tf2_msgs/TFMessage, the odom stamp; '
+          'rotation only) when tf2_msgs is importable (on a ROS install; pip-only installs '
+          'have no tf2_msgs and the node says so).', read_only=True),
     Param('publish_imu', 'bool', True, 'true',
           'Also publish sensor_msgs/Imu on imu (REP 145; no acceleration) and the true gyro '
           'bias on ~/imu_bias.', read_only=True),
@@ -313,9 +317,14 @@ class AttitudeSimulator(Node):
 
     # ------------------------------------------------------------------ interfaces
     def _make_interfaces(self):
+        publish_tf = self.get_parameter('publish_tf').value
         self.state = StatePublisher(self, self._frames,
                                     publish_imu=self.get_parameter('publish_imu').value,
-                                    publish_clock=self._publish_clock)
+                                    publish_clock=self._publish_clock, publish_tf=publish_tf)
+        if publish_tf and not tf_available():
+            self.get_logger().info('publish_tf: tf2_msgs is not importable here (no tf2_msgs '
+                                   'wheel exists; on a ROS install it is), so /tf is not '
+                                   'broadcast; odom carries the same pose')
         self._pub_diag = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self._pub_rtf = self.create_publisher(Float64, '~/real_time_factor', 10)
         self.create_subscription(

@@ -6,13 +6,15 @@ subscriptions and services; this object owns the publishers of ``odom``,
 ``orientation``, ``angular_velocity``, ``angular_momentum``,
 ``angular_momentum_body``, ``applied_torque``, ``imu`` and ``~/imu_bias``
 (optional; from the engine's gyro samples), the latched
-``inertia`` and ``/clock`` (optional), and turns an engine
+``inertia``, ``/clock`` (optional) and ``/tf`` (optional: world -> body
+frame, when tf2_msgs is importable, as on every ROS install), and turns an engine
 :class:`~rigid_body_dynamics.engine.body.Snapshot` into their messages. All
 messages of one tick carry the snapshot's stamp; vectors are published in the
 user's body frame (``body_frame``) or the world frame (``world_frame``).
 """
 
-from geometry_msgs.msg import InertiaStamped, QuaternionStamped, Vector3Stamped, WrenchStamped
+from geometry_msgs.msg import InertiaStamped, QuaternionStamped, TransformStamped
+from geometry_msgs.msg import Vector3Stamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -24,6 +26,11 @@ from . import conversions as conv
 from ..engine import ImuSample
 from ..physics import quaternions
 
+try:
+    from tf2_msgs.msg import TFMessage
+except ImportError:     # pip-only installs: no tf2_msgs wheel exists
+    TFMessage = None
+
 STATE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
                        reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.VOLATILE)
@@ -32,12 +39,21 @@ LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
 CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                        reliability=ReliabilityPolicy.BEST_EFFORT)
+#: tf2_ros' TransformBroadcaster QoS (DynamicBroadcasterQoS): reliable, volatile, depth 100.
+TF_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+                    reliability=ReliabilityPolicy.RELIABLE,
+                    durability=DurabilityPolicy.VOLATILE)
+
+
+def tf_available():
+    """Whether tf2_msgs can be imported here (always on a ROS install; not from pip)."""
+    return TFMessage is not None
 
 
 class StatePublisher:
     """The state publishers of one body on ``node``: ``frames`` = (world, body) frame ids."""
 
-    def __init__(self, node, frames, publish_imu=True, publish_clock=False):
+    def __init__(self, node, frames, publish_imu=True, publish_clock=False, publish_tf=False):
         self.world_frame, self.body_frame = frames
         qos_opts = QoSOverridingOptions.with_default_policies()
 
@@ -55,6 +71,8 @@ class StatePublisher:
         self._inertia = pub(InertiaStamped, 'inertia', LATCHED_QOS)
         self._clock = node.create_publisher(ClockMsg, '/clock', CLOCK_QOS) \
             if publish_clock else None
+        self._tf = node.create_publisher(TFMessage, '/tf', TF_QOS) \
+            if publish_tf and tf_available() else None
 
     def publish(self, snapshot):
         """Publish one engine item: a Snapshot's state topics, or an ImuSample's imu and bias."""
@@ -93,6 +111,22 @@ class StatePublisher:
         self._torque.publish(wrench)
         if self._clock is not None:
             self._clock.publish(ClockMsg(clock=stamp))
+        if self._tf is not None:
+            tf = TransformStamped()
+            tf.header.stamp, tf.header.frame_id, tf.child_frame_id = stamp, world, body_frame
+            tf.transform.rotation = q_msg
+            self._tf.publish(TFMessage(transforms=[tf]))
+
+    @property
+    def broadcasts_tf(self):
+        """Whether this publisher broadcasts world -> body on /tf."""
+        return self._tf is not None
+
+    def stop_tf(self, node):
+        """Stop broadcasting /tf (the fleet does so for bodies that share a body frame)."""
+        if self._tf is not None:
+            node.destroy_publisher(self._tf)
+            self._tf = None
 
     def publish_imu(self, sample):
         """
