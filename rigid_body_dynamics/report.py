@@ -30,14 +30,26 @@ import numpy as np
 from .bags import BagError, BagWriter, INERTIA, ODOMETRY, read_trajectory, WRENCH
 from .physics import estimators, INTEGRATORS, presets, quaternions, simulate
 from .physics.analysis import analyse, Trajectory
+from .physics.sensors import allan_deviation, GyroErrors, GyroModel
 
 
-def offline_run(preset, integrator, duration, dt, progress=None):
-    """Simulate a preset into a Trajectory; ``progress(fraction)`` is called as it goes."""
+def offline_run(preset, integrator, duration, dt, progress=None, gyro=None):
+    """
+    Simulate a preset into a Trajectory; ``progress(fraction)`` is called as it goes.
+
+    With ``gyro`` (a GyroModel) returns (trajectory, gyro error): the gyro's
+    readings minus the true rate at its samples, (M, 3) rad/s body frame, and
+    its rate (Hz), for :func:`make_report`'s Allan-deviation figure.
+    """
     body = presets.get(preset)
     result = simulate(body.moments, body.omega0, body.q0, duration, dt, integrator=integrator,
-                      progress=progress)
-    return Trajectory.from_simulation(result, title=f'{preset} ({integrator}, dt = {dt:g} s)')
+                      progress=progress, gyro=gyro)
+    run = Trajectory.from_simulation(result, title=f'{preset} ({integrator}, dt = {dt:g} s)')
+    if gyro is None:
+        return run
+    imu = result.imu
+    every = round(1.0 / (imu.rate * dt))
+    return run, (imu.omega - result.omega[::every], imu.rate)
 
 
 def record(path, duration, timeout=60.0):
@@ -115,12 +127,45 @@ def _save(fig, out_dir, name):
     return path
 
 
-def make_report(run, out_dir):
+def allan_figure(error, rate, errors, out_dir):
+    """
+    Allan deviation of a gyro's error with the lines of its ``errors`` (GyroErrors).
+
+    ``error`` (M, 3) rad/s: readings minus the true rate, as a calibration on
+    a still table sees the gyro; ``rate`` Hz. Cluster times from one sample to
+    a tenth of the record. Returns (png path, curves) like every figure.
+    """
+    span = error.shape[0] / rate
+    taus = np.logspace(math.log10(1.0 / rate), math.log10(max(span / 10.0, 2.0 / rate)), 40)
+    fig, ax = _figure('Allan deviation of the simulated gyro (its error; all axes)',
+                      'cluster time tau (s)', 'Allan deviation (rad/s)')
+    curves = {}
+    for axis in range(3):
+        used, adev = allan_deviation(error[:, axis], rate, taus)
+        ax.loglog(used, adev, label=f'axis {axis + 1}')
+        curves[f'axis {axis + 1}'] = np.stack([used, adev], axis=1)
+    n, k = errors.noise_density, errors.bias_random_walk
+    if n:
+        ax.loglog(used, n / np.sqrt(used), 'k--', label=f'N / sqrt(tau), N = {n:g}')
+        curves['N / sqrt(tau)'] = n / np.sqrt(used)
+    if k:
+        label = f'K sqrt(tau / 3), K = {k:g}'
+        if errors.correlation_time:
+            label += f' (Gauss-Markov, tau_c = {errors.correlation_time:g} s)'
+        ax.loglog(used, k * np.sqrt(used / 3.0), 'k:', label=label)
+        curves['K sqrt(tau / 3)'] = k * np.sqrt(used / 3.0)
+    ax.legend(loc='best')
+    return _save(fig, out_dir, 'allan.png'), curves
+
+
+def make_report(run, out_dir, gyro=None):
     """
     Write the figures and index.html for ``run`` into ``out_dir``.
 
-    Returns {figure name: (png path, {curve label: plotted array})} so that
-    callers (and tests) can check what each figure shows, and the table rows.
+    ``gyro``: optional (error (M, 3) rad/s, rate Hz, GyroErrors) from
+    :func:`offline_run` for the Allan-deviation figure. Returns {figure name:
+    (png path, {curve label: plotted array})} so that callers (and tests)
+    can check what each figure shows, and the table rows.
     """
     os.makedirs(out_dir, exist_ok=True)
     inertia = run.inertia
@@ -202,6 +247,8 @@ def make_report(run, out_dir):
         ax.legend(loc='best')
         figures['flips'] = (_save(fig, out_dir, 'flips.png'),
                             {'omega': w[:, mid], 'flips': crossings})
+    if gyro is not None:
+        figures['allan'] = allan_figure(*gyro, out_dir)
     rows = findings_rows(found)
     _write_html(run, out_dir, figures, rows)
     return figures, rows
@@ -276,7 +323,18 @@ def main(argv=None):
     parser.add_argument('--duration', type=float, help='simulated / recorded seconds (of stamps)')
     parser.add_argument('--dt', type=float, default=1e-3, help='step (s), offline')
     parser.add_argument('--out', default='report', help='output folder (default ./report)')
+    noise = parser.add_argument_group(
+        'simulated gyro (offline; adds an Allan-deviation figure; README "Sensor noise")')
+    noise.add_argument('--gyro-noise-density', type=float, default=0.0, metavar='N',
+                       help='white rate noise N (rad/s/sqrt(Hz))')
+    noise.add_argument('--gyro-bias-random-walk', type=float, default=0.0, metavar='K',
+                       help='bias random walk K (rad/s^2/sqrt(Hz))')
+    noise.add_argument('--gyro-bias-correlation-time', type=float, default=0.0, metavar='S',
+                       help='Gauss-Markov bias correlation time (s; 0 = random walk)')
+    noise.add_argument('--imu-rate', type=float, default=100.0, help='gyro rate (Hz)')
+    noise.add_argument('--noise-seed', type=int, default=0)
     args = parser.parse_args(argv)
+    gyro = None
     try:
         if args.bag:
             run = read_trajectory(args.bag)[0]
@@ -294,8 +352,16 @@ def main(argv=None):
                     last[0] = step
                     print(f'simulating {name}: {100 * fraction:3.0f} % of {duration:g} s',
                           file=sys.stderr, flush=True)
-            run = offline_run(name, args.integrator, duration, args.dt, progress)
-        figures, rows = make_report(run, args.out)
+            errors = GyroErrors(args.gyro_noise_density, args.gyro_bias_random_walk,
+                                correlation_time=args.gyro_bias_correlation_time)
+            if errors.noise_density or errors.bias_random_walk:
+                run, (error, rate) = offline_run(
+                    name, args.integrator, duration, args.dt, progress,
+                    GyroModel(errors, args.imu_rate, seed=args.noise_seed))
+                gyro = (error, rate, errors)
+            else:
+                run = offline_run(name, args.integrator, duration, args.dt, progress)
+        figures, rows = make_report(run, args.out, gyro)
     except ValueError as err:
         print(f'rigid_body_report: {err}', file=sys.stderr)
         return 2

@@ -39,6 +39,38 @@ def test_symmetric_report_has_precession_against_theory(tmp_path):
     assert measured['body precession rate (rad/s)'] == pytest.approx(1.0, rel=1e-12)
 
 
+def test_allan_figure_of_the_simulated_gyro_shows_its_n_and_k(tmp_path, capsys):
+    """
+    --gyro-noise-density 1e-3 --gyro-bias-random-walk 1e-4 over 600 s at 100 Hz.
+
+    The figure's curves are the Allan deviation of readings minus truth: at 1 s it is N's
+    line (the walk adds K sqrt(1/3) = 6e-5 in quadrature, under 0.2 %), at 60 s K's line
+    dominates (N / sqrt(60) = 1.3e-4 against K sqrt(20) = 4.5e-4). A 600 s record gives
+    about 5 % / 20 % statistical scatter there, so the bounds are 10 % / 35 %.
+    """
+    assert report.main(['--preset', 'stable_major', '--duration', '600', '--dt', '0.01',
+                        '--gyro-noise-density', '1e-3', '--gyro-bias-random-walk', '1e-4',
+                        '--out', str(tmp_path)]) == 0
+    assert 'allan.png' in capsys.readouterr().out
+    assert 'allan.png' in open(tmp_path / 'index.html').read()
+    from rigid_body_dynamics.physics.sensors import GyroErrors, GyroModel
+    errors = GyroErrors(1e-3, 1e-4)
+    run, gyro = report.offline_run('stable_major', 'exact', 600.0, 0.01,
+                                   gyro=GyroModel(errors, 100.0))
+    figures, _ = report.make_report(run, str(tmp_path / 'again'), (*gyro, errors))
+    curves = figures['allan'][1]
+    tau = curves['axis 1'][:, 0]
+    adev = np.mean([curves[f'axis {a}'][:, 1] for a in (1, 2, 3)], axis=0)
+    np.testing.assert_allclose(curves['N / sqrt(tau)'], 1e-3 / np.sqrt(tau), rtol=1e-12)
+    np.testing.assert_allclose(curves['K sqrt(tau / 3)'], 1e-4 * np.sqrt(tau / 3), rtol=1e-12)
+    at_1 = np.argmin(abs(np.log(tau)))
+    at_60 = np.argmin(abs(np.log(tau / 60.0)))
+    assert adev[at_1] == pytest.approx(1e-3 / np.sqrt(tau[at_1]), rel=0.10)
+    assert adev[at_60] == pytest.approx(np.hypot(1e-3 / np.sqrt(tau[at_60]),
+                                                 1e-4 * np.sqrt(tau[at_60] / 3)), rel=0.35)
+    assert tau[0] == pytest.approx(0.01) and tau[-1] == pytest.approx(60.0, rel=0.02)
+
+
 def test_report_from_a_bag_and_bad_input(tmp_path, capsys):
     run = report.offline_run('stable_major', 'rk4', 5.0, 0.01)
     t_ns = 1_764_547_200_000_000_000 + run.t_ns

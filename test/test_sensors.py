@@ -104,3 +104,55 @@ def test_gazebo_conversion_and_bad_parameters():
             GyroErrors(**{name: math.nan})
     with pytest.raises(ValueError, match='rate'):
         GyroModel(GyroErrors(), 0.0)
+
+
+def test_allan_deviation_equals_allantools_overlapping_adev():
+    """physics.sensors.allan_deviation against allantools.oadev (frequency data) to 1e-12."""
+    import allantools
+    from rigid_body_dynamics.physics.sensors import allan_deviation
+    gyro = GyroModel(GyroErrors(noise_density=1e-3, bias_random_walk=1e-4), RATE, seed=21)
+    x = gyro.sample(np.zeros((20_000, 3)))[0][:, 0]
+    taus, adev = allan_deviation(x, RATE, [0.01, 0.1, 0.5, 1.0, 3.0, 10.0, 50.0])
+    ref_taus, ref, _, _ = allantools.oadev(x, rate=RATE, data_type='freq', taus=taus)
+    np.testing.assert_allclose(ref_taus, taus, rtol=1e-12)
+    np.testing.assert_allclose(adev, ref, rtol=1e-12)
+
+
+def test_four_hours_of_gyro_read_n_at_1_s_and_k_at_3_s_within_5_percent():
+    """
+    A user's N = 1e-3 rad/s/sqrt(Hz) and K = 1e-5 rad/s^2/sqrt(Hz), 4 h at 100 Hz, 3 axes.
+
+    Each term alone (the other would dominate at the reading point): white noise gives
+    ADEV(1 s) = N, the bias random walk ADEV(3 s) = K, within 5 % (mean over the axes).
+    """
+    from rigid_body_dynamics.physics.sensors import allan_deviation
+    samples = int(4 * 3600 * RATE)
+    white = GyroModel(GyroErrors(noise_density=1e-3), RATE, seed=31).sample(
+        np.zeros((samples, 3)))[0]
+    walk = GyroModel(GyroErrors(bias_random_walk=1e-5), RATE, seed=32).sample(
+        np.zeros((samples, 3)))[0]
+    n_read = np.mean([allan_deviation(white[:, a], RATE, [1.0])[1][0] for a in range(3)])
+    k_read = np.mean([allan_deviation(walk[:, a], RATE, [3.0])[1][0] for a in range(3)])
+    assert n_read == pytest.approx(1e-3, rel=0.05)
+    assert k_read == pytest.approx(1e-5, rel=0.05)
+
+
+def test_simulate_with_a_gyro_reads_the_run_at_the_gyro_rate():
+    """simulate(gyro=...) reads the trajectory at every 5th step, in the node's draw order."""
+    from rigid_body_dynamics.physics import simulate
+    errors = GyroErrors(noise_density=1e-3, bias_random_walk=1e-4, turn_on_bias=1e-3,
+                        orientation_noise=0.01)
+    run = simulate((1.0, 2.0, 3.0), (0.3, 1.5, -0.4), duration=1.0, dt=1e-3,
+                   gyro=GyroModel(errors, 200.0, seed=4))
+    imu = run.imu
+    assert imu.rate == 200.0 and imu.t.shape == (201,)
+    np.testing.assert_allclose(imu.t, run.t[::5], rtol=0, atol=1e-15)
+    ref = GyroModel(errors, 200.0, seed=4)
+    readings = [ref.read(q, w) for q, w in zip(run.q[::5], run.omega[::5])]
+    np.testing.assert_array_equal(imu.q, [r[0] for r in readings])
+    np.testing.assert_array_equal(imu.omega, [r[1] for r in readings])
+    np.testing.assert_array_equal(imu.bias, [r[2] for r in readings])
+    assert np.max(np.abs(imu.omega - run.omega[::5])) > 1e-3
+    with pytest.raises(ValueError, match='whole fraction'):
+        simulate((1.0, 2.0, 3.0), (0.3, 1.5, -0.4), duration=0.1, dt=1e-3,
+                 gyro=GyroModel(errors, 300.0))

@@ -17,8 +17,8 @@ import pytest
 from rcl_interfaces.srv import SetParameters
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
-from rigid_body_dynamics.nodes.conversions import time_ns, vector_array
-from rigid_body_dynamics.physics import FreeRigidBody, Inertia, quaternions, simulate
+from rigid_body_dynamics.nodes.conversions import quaternion_array, time_ns, vector_array
+from rigid_body_dynamics.physics import FreeRigidBody, Inertia, presets, quaternions, simulate
 from ros_harness import assert_exact, LATCHED, odom_arrays, relative, stamp, status_count
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import SetBool, Trigger
@@ -374,12 +374,12 @@ def test_thread_priority_is_applied_or_refused_with_the_reason(launch, probe):
 
 def test_noisy_gyro_stream_is_the_seeded_model_at_the_imu_stamps(launch, probe):
     """
-    The imu topic carries the seeded gyro model's measurement, ~/imu_bias its true bias.
+    The imu topic carries what offline simulate(gyro=...) reads, ~/imu_bias its true bias.
 
     Gyro at 200 Hz (every 5th step), noise density 1e-3, bias random walk 1e-4, turn-on bias
-    1e-3, seed 42. The stream is a function of the sample index only, so the offline model fed
-    the exact torque-free rates at the same stamps reproduces every received sample (to the
-    1e-13 the exact flow and the simulator's rates differ by).
+    1e-3, orientation noise 0.01 rad, seed 42. The stream is a function of the sample index
+    only, so the offline run with the same model reproduces every received sample (rates and
+    orientations to 1e-12, the bias bit for bit).
     """
     from sensor_msgs.msg import Imu
     from rigid_body_dynamics.physics.sensors import GyroErrors, GyroModel
@@ -387,26 +387,32 @@ def test_noisy_gyro_stream_is_the_seeded_model_at_the_imu_stamps(launch, probe):
     proc = launch(SIM, '-p', 'publish_clock:=true', '-p', 'inertia:=[1.0, 2.0, 3.0]',
                   '-p', 'initial_angular_velocity:=[0.3, 1.5, -0.4]', '-p', 'imu_rate:=200.0',
                   '-p', 'gyro_noise_density:=0.001', '-p', 'gyro_bias_random_walk:=0.0001',
-                  '-p', 'gyro_turn_on_bias:=0.001', '-p', 'noise_seed:=42',
-                  '-p', 'real_time_factor:=2.0', name='sim')
+                  '-p', 'gyro_turn_on_bias:=0.001', '-p', 'orientation_noise:=0.01',
+                  '-p', 'noise_seed:=42', '-p', 'real_time_factor:=2.0', name='sim')
     imu = probe.subscribe(Imu, 'imu')
     bias = probe.subscribe(Vector3Stamped, f'{NODE}/imu_bias')
     probe.spin_until(lambda: len(imu) > 300 and len(bias) > 300, 30.0, '300 gyro samples')
     index = np.array([time_ns(m.header.stamp) for m in imu]) // 5_000_000
     assert np.all(np.array([time_ns(m.header.stamp) for m in imu]) % 5_000_000 == 0)
-    model = GyroModel(GyroErrors(1e-3, 1e-4, 1e-3), 200.0, seed=42)
-    stamps = np.arange(index.max() + 1) * 5e-3
-    _, w_true = FreeRigidBody((1.0, 2.0, 3.0), omega0).state_at(stamps)
-    expected, expected_bias = model.sample(w_true)
+    model = GyroModel(GyroErrors(1e-3, 1e-4, 1e-3, orientation_noise=0.01), 200.0, seed=42)
+    offline = simulate((1.0, 2.0, 3.0), omega0, duration=index.max() * 5e-3, dt=1e-3,
+                       gyro=model).imu
     measured = np.array([vector_array(m.angular_velocity) for m in imu])
-    np.testing.assert_allclose(measured, expected[index], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(measured, offline.omega[index], rtol=0, atol=1e-12)
+    reported = np.array([quaternion_array(m.orientation) for m in imu])
+    np.testing.assert_allclose(reported, offline.q[index], rtol=0, atol=1e-12)
+    _, w_true = FreeRigidBody((1.0, 2.0, 3.0), omega0).state_at(offline.t)
     assert np.max(np.abs(measured - w_true[index])) > 1e-3        # the noise is really there
     b_index = np.array([time_ns(m.header.stamp) for m in bias]) // 5_000_000
     np.testing.assert_array_equal(np.array([vector_array(m.vector) for m in bias]),
-                                  expected_bias[b_index])
+                                  offline.bias[b_index])
+    # the white noise over topics: imu - truth - bias has N sqrt(rate) per sample, within 10 %
+    white = measured - w_true[index] - offline.bias[index]
+    assert white.std() == pytest.approx(1e-3 * math.sqrt(200.0), rel=0.10)
     cov = imu[-1].angular_velocity_covariance
     assert [cov[0], cov[4], cov[8]] == pytest.approx([1e-6 * 200.0] * 3, rel=1e-14)  # N^2 rate
     assert cov[1] == 0.0
+    assert list(imu[-1].orientation_covariance)[::4] == pytest.approx([1e-4] * 3, rel=1e-14)
     assert imu[-1].linear_acceleration_covariance[0] == -1.0
     stop_cleanly(proc)
 
@@ -457,4 +463,49 @@ def test_without_tf2_msgs_the_simulator_says_so_and_runs(launch, probe):
     probe.wait_for('odom', 5)                       # running: the state topics are there
     assert probe.node.get_publishers_info_by_topic('/tf') == []
     assert 'tf2_msgs is not importable' in proc.output()
+    stop_cleanly(proc)
+
+
+def test_readme_sensor_noise_yaml_gives_that_gyro(launch, probe, tmp_path):
+    """
+    The parameters file of README's "Sensor noise", as a user passes it, sets the imu stream.
+
+    N = 1e-4 at 200 Hz: angular velocity covariance N^2 * 200 = 2e-6, orientation 0.002^2;
+    the stream is seed 7's (the offline model's at every index; the bias bit for bit) and
+    imu minus truth minus bias has N sqrt(200) per sample (within 10 %).
+    """
+    import re
+    from sensor_msgs.msg import Imu
+    from rigid_body_dynamics.physics.sensors import GyroErrors, GyroModel
+    readme = open(os.path.join(os.path.dirname(__file__), '..', 'README.md')).read()
+    block = re.search(r'<!-- sensor-noise-example -->\n```yaml\n(.*?)```', readme, re.S).group(1)
+    params = tmp_path / 'gyro.yaml'
+    params.write_text(block)
+    proc = launch(SIM, '--params-file', str(params), '-p', 'publish_clock:=true',
+                  '-p', 'real_time_factor:=4.0', name='sim_yaml')
+    imu = probe.subscribe(Imu, 'imu')
+    bias = probe.subscribe(Vector3Stamped, f'{NODE}/imu_bias')
+    probe.spin_until(lambda: len(imu) > 400 and len(bias) > 400, 30.0, '400 gyro samples')
+    stamps = np.array([time_ns(m.header.stamp) for m in imu])
+    assert np.all(np.diff(stamps) == 5_000_000)                   # 200 Hz
+    cov = imu[-1].angular_velocity_covariance
+    assert [cov[0], cov[4], cov[8]] == pytest.approx([1e-8 * 200.0] * 3, rel=1e-14)
+    assert list(imu[-1].orientation_covariance)[::4] == pytest.approx([4e-6] * 3, rel=1e-14)
+    # every received sample is the offline model's at its index (bias bit for bit)
+    index = stamps // 5_000_000
+    preset = presets.get(presets.DEFAULT)
+    offline = simulate(preset.moments, preset.omega0, preset.q0, duration=index.max() * 5e-3,
+                       dt=1e-3, gyro=GyroModel(GyroErrors(1e-4, 1e-6, 1e-3,
+                                                          orientation_noise=0.002),
+                                               200.0, seed=7)).imu
+    b_index = np.array([time_ns(m.header.stamp) for m in bias]) // 5_000_000
+    b = np.array([vector_array(m.vector) for m in bias])
+    np.testing.assert_array_equal(b, offline.bias[b_index])
+    assert np.all(b.std(axis=0) > 0.0)                            # the bias walks
+    measured = np.array([vector_array(m.angular_velocity) for m in imu])
+    np.testing.assert_allclose(measured, offline.omega[index], rtol=0, atol=1e-12)
+    truth = simulate(preset.moments, preset.omega0, preset.q0, duration=index.max() * 5e-3,
+                     dt=1e-3, every=5).omega
+    white = measured - truth[index] - offline.bias[index]
+    assert white.std() == pytest.approx(1e-4 * math.sqrt(200.0), rel=0.10)
     stop_cleanly(proc)

@@ -285,11 +285,10 @@ class BodySimulation:
 
     def imu_sample(self):
         """Sample the gyro at the current state (call under ``lock``): an :class:`ImuSample`."""
-        q_b, w_b = self.body_state()
-        measured, bias = self.gyro.measure(w_b)
         gyro = self.gyro
+        q, measured, bias = gyro.read(*self.body_state())
         return ImuSample(self.start_ns + int(self.steps * self.dt_ns),
-                         tuple(float(c) for c in gyro.orientation(q_b)),
+                         tuple(float(c) for c in q),
                          tuple(float(c) for c in measured), tuple(float(c) for c in bias),
                          gyro.rate_variance, gyro.orientation_variance)
 

@@ -7,11 +7,11 @@ Public API (stable): :class:`Inertia`, :class:`FreeRigidBody`,
 :data:`INTEGRATORS` / :func:`make_integrator`.
 """
 
-from . import analysis, control, estimators, presets, theory
+from . import analysis, control, estimators, presets, sensors, theory
 from .free_motion import FreeRigidBody
 from .inertia import Inertia
 from .integrators import INTEGRATORS, make_integrator
 from .simulation import simulate, SimulationResult
 
 __all__ = ['analysis', 'control', 'estimators', 'FreeRigidBody', 'Inertia', 'INTEGRATORS',
-           'make_integrator', 'presets', 'simulate', 'SimulationResult', 'theory']
+           'make_integrator', 'presets', 'sensors', 'simulate', 'SimulationResult', 'theory']

@@ -124,14 +124,29 @@ class GyroModel:
             bias = np.repeat(self.bias[None, :], n, axis=0)
             return omega + bias, bias
         draws = self._rng.standard_normal((n, 2, 3))
-        bias = np.empty((n, 3))
-        b = self.bias
         phi, walk = self._phi, self._walk
-        for k in range(n):
-            bias[k] = b
-            b = phi * b + walk * draws[k, 1]
-        self.bias = b
+        if phi == 1.0:      # a random walk: b[k] = ((b[0] + s w[0]) + s w[1]) ..., in order
+            path = np.cumsum(np.concatenate([self.bias[None, :], walk * draws[:, 1]]), axis=0)
+            bias, self.bias = path[:-1], path[-1]
+        else:
+            bias = np.empty((n, 3))
+            b = self.bias
+            for k in range(n):
+                bias[k] = b
+                b = phi * b + walk * draws[k, 1]
+            self.bias = b
         return omega + bias + self._white * draws[:, 0], bias
+
+    def read(self, q, omega):
+        """
+        Take one IMU reading of the true attitude q (x, y, z, w) and rate omega (3,) rad/s.
+
+        Returns (reported q, measured rate, bias in it), body frame: the rate is
+        drawn first, then the orientation noise, the order the simulator uses,
+        so a stream offline and one over topics are the same.
+        """
+        measured, bias = self.measure(omega)
+        return self.orientation(q), measured, bias
 
     def orientation(self, q):
         """Return the attitude q (x, y, z, w) with the orientation noise applied (body frame)."""
@@ -143,3 +158,27 @@ class GyroModel:
         axis = v / angle if angle > 0.0 else np.array([1.0, 0.0, 0.0])
         return quaternions.multiply(np.asarray(q, dtype=float),
                                     quaternions.from_axis_angle(axis, angle))
+
+
+def allan_deviation(rates, rate, taus):
+    """
+    Overlapping Allan deviation of a rate signal at cluster times ``taus`` (s).
+
+    ``rates`` (N,) rad/s sampled at ``rate`` Hz; each tau is rounded to a whole
+    number m of samples (1 <= m <= (N - 1) / 2). Returns (the taus used (s),
+    the deviations (rad/s)); white noise of density N gives N / sqrt(tau), a
+    bias random walk K gives K sqrt(tau / 3). Written here rather than taken
+    from allantools (which the tests compare it with) so that the report
+    needs no package a ROS install lacks.
+    """
+    x = np.asarray(rates, dtype=float).ravel()
+    theta = np.concatenate(([0.0], np.cumsum(x))) / rate       # integrated angle (rad)
+    n = x.size
+    ms = np.unique(np.clip(np.round(np.asarray(taus, dtype=float) * rate), 1, (n - 1) // 2)
+                   ).astype(int)
+    out = np.empty(ms.size)
+    for i, m in enumerate(ms):
+        tau = m / rate
+        d = theta[2 * m:] - 2.0 * theta[m:-m] + theta[:-2 * m]
+        out[i] = math.sqrt(np.mean(d * d) / (2.0 * tau * tau))
+    return ms / rate, out

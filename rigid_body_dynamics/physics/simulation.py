@@ -17,6 +17,23 @@ from .integrators import make_integrator
 
 
 @dataclass
+class ImuStream:
+    """
+    A gyro's readings over a run (``simulate(..., gyro=...)``), user's body frame.
+
+    ``t`` (M,) s (every ``every``-th step from 0); ``q`` (M, 4) the reported
+    attitude (with orientation noise); ``omega`` (M, 3) the measured rate
+    (rad/s); ``bias`` (M, 3) the true bias in it (rad/s); ``rate`` Hz.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    omega: np.ndarray
+    bias: np.ndarray
+    rate: float
+
+
+@dataclass
 class SimulationResult:
     """
     Sampled trajectory of one run.
@@ -24,7 +41,8 @@ class SimulationResult:
     ``t`` (N,) s; ``q`` (N, 4) x-y-z-w body -> world; ``omega`` (N, 3) rad/s
     body frame; ``torque`` (N, 3) N m body frame, the torque held over the
     step that starts at each sample (last row repeats); ``work`` (N,) J and
-    ``impulse`` (N, 3) N m s world frame, accumulated by the integrator.
+    ``impulse`` (N, 3) N m s world frame, accumulated by the integrator;
+    ``imu`` an :class:`ImuStream` when a gyro was given, else None.
     """
 
     t: np.ndarray
@@ -35,6 +53,7 @@ class SimulationResult:
     impulse: np.ndarray
     inertia: object
     integrator: str
+    imu: object = None
 
     @property
     def kinetic_energy(self):
@@ -54,7 +73,7 @@ class SimulationResult:
 
 
 def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
-             integrator='exact', torque=None, every=1, progress=None):
+             integrator='exact', torque=None, every=1, progress=None, gyro=None):
     """
     Integrate the rigid body for ``duration`` s with fixed steps ``dt`` s.
 
@@ -65,8 +84,11 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     each step and held over it (the last row repeats the last torque).
     ``integrator`` is a name from INTEGRATORS.
     ``every``: keep every n-th step. ``progress(fraction)``, if given, is
-    called about a hundred times as the run goes (for long runs). Returns a
-    :class:`SimulationResult` including t = 0.
+    called about a hundred times as the run goes (for long runs). ``gyro``: a
+    :class:`~rigid_body_dynamics.physics.sensors.GyroModel` whose rate is a
+    whole fraction of 1 / dt, read at every one of its samples from t = 0 (its
+    stream is the one attitude_simulator publishes on ``imu`` with the same
+    seed and parameters). Returns a :class:`SimulationResult` including t = 0.
     """
     inertia = as_inertia(inertia)
     if not (math.isfinite(duration) and duration >= 0.0):
@@ -74,6 +96,8 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     if not (math.isfinite(dt) and dt > 0.0):
         raise ValueError(f'dt must be positive and finite, got {dt!r}')
     n = int(round(duration / dt))
+    imu_every = _imu_every(gyro, dt)
+    imu = ([], [], [], [])
     q0 = np.asarray(q0, dtype=float)
     stepper = make_integrator(integrator, inertia.moments, dt,
                               inertia.attitude_to_principal(q0 / np.linalg.norm(q0)),
@@ -100,6 +124,10 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
             tau.append(tb)
             work.append(stepper.work)
             imp.append(stepper.impulse)
+        if imu_every and k % imu_every == 0:
+            for column, value in zip(imu, (stepper.time, *gyro.read(
+                    *_user_state(inertia, stepper)))):
+                column.append(value)
         if k < n:
             try:
                 step(tp)
@@ -111,7 +139,22 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     return SimulationResult(t=np.array(t), q=inertia.attitude_to_body(np.array(q)),
                             omega=inertia.to_body(np.array(w)), torque=tau,
                             work=np.array(work), impulse=np.array(imp).reshape(-1, 3),
-                            inertia=inertia, integrator=integrator)
+                            inertia=inertia, integrator=integrator,
+                            imu=ImuStream(np.array(imu[0]), np.array(imu[1]).reshape(-1, 4),
+                                          np.array(imu[2]).reshape(-1, 3),
+                                          np.array(imu[3]).reshape(-1, 3), gyro.rate)
+                            if imu_every else None)
+
+
+def _imu_every(gyro, dt):
+    """Return the steps per gyro sample (0 without a gyro); ValueError unless whole."""
+    if gyro is None:
+        return 0
+    every = round(1.0 / (gyro.rate * dt))
+    if every < 1 or abs(every * gyro.rate * dt - 1.0) > 1e-9:
+        raise ValueError(f'the gyro rate ({gyro.rate:g} Hz) must be a whole fraction of the '
+                         f'step rate 1 / dt = {1.0 / dt:g} Hz')
+    return every
 
 
 def _principal(inertia, torque_body, t):
