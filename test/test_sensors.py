@@ -97,7 +97,7 @@ def test_gazebo_conversion_and_bad_parameters():
     assert (errors.turn_on_bias, errors.bias_random_walk, errors.correlation_time) == (
         0.002, 4e-6, 1000.0)
     for name in ('noise_density', 'bias_random_walk', 'turn_on_bias', 'correlation_time',
-                 'orientation_noise'):
+                 'orientation_noise', 'resolution'):
         with pytest.raises(ValueError, match=name):
             GyroErrors(**{name: -1.0})
         with pytest.raises(ValueError, match=name):
@@ -156,3 +156,21 @@ def test_simulate_with_a_gyro_reads_the_run_at_the_gyro_rate():
     with pytest.raises(ValueError, match='whole fraction'):
         simulate((1.0, 2.0, 3.0), (0.3, 1.5, -0.4), duration=0.1, dt=1e-3,
                  gyro=GyroModel(errors, 300.0))
+
+
+def test_quantised_readings_are_whole_counts_with_the_r2_over_12_variance():
+    """Resolution r = 1e-3 rad/s on white noise 1e-2 per sample: counts, variance + r^2/12."""
+    r = 1e-3
+    gyro = GyroModel(GyroErrors(noise_density=1e-3, resolution=r), RATE, seed=41)
+    plain = GyroModel(GyroErrors(noise_density=1e-3), RATE, seed=41)
+    omega = np.full((200_000, 3), 0.123456)
+    measured, _ = gyro.sample(omega)
+    exact, _ = plain.sample(omega)
+    counts = measured / r
+    np.testing.assert_allclose(counts, np.round(counts), rtol=0, atol=1e-6)
+    assert np.max(np.abs(measured - exact)) <= 0.5 * r * (1 + 1e-9)   # nearest count
+    error = measured - exact
+    assert error.var() == pytest.approx(r * r / 12.0, rel=0.02)
+    assert gyro.rate_variance == plain.rate_variance                  # N^2 rate, as documented
+    still = GyroModel(GyroErrors(resolution=0.01), RATE).sample(np.full((3, 3), 0.123))[0]
+    np.testing.assert_allclose(still, 0.12, rtol=0, atol=1e-15)

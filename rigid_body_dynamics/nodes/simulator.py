@@ -220,6 +220,10 @@ PARAMETERS = ParameterTable([
     Param('orientation_noise', 'double', 0.0, '0.0 rad',
           'Standard deviation per axis of a random rotation applied to the imu orientation.',
           low=0.0, high=3.0, read_only=True),
+    Param('gyro_resolution', 'double', 0.0, '0.0 rad/s',
+          'Quantisation step of the gyro reading (one count; Gazebo precision); adds '
+          'resolution^2 / 12 of variance that the covariance does not include. 0 = none.',
+          low=0.0, high=1e3, read_only=True),
     Param('noise_seed', 'int', 0, '0',
           'Seed of the gyro noise: the same seed and parameters give the same imu stream, bit '
           'for bit (also after ~/reset).', low=0, high=2 ** 31 - 1, read_only=True),
@@ -264,7 +268,7 @@ class AttitudeSimulator(Node):
             imu_every=self._publish_every(values['imu_rate']) if values['publish_imu'] else 0,
             gyro=GyroErrors(values['gyro_noise_density'], values['gyro_bias_random_walk'],
                             values['gyro_turn_on_bias'], values['gyro_bias_correlation_time'],
-                            values['orientation_noise']),
+                            values['orientation_noise'], values['gyro_resolution']),
             seed=values['noise_seed'])
         self._publish_rate = values['publish_rate']
         self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog)

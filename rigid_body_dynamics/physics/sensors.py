@@ -22,6 +22,11 @@ turn-on ``bias_stddev`` is ``turn_on_bias`` here (Gazebo also draws a random
 sign around ``bias_mean``; not modelled). Orientation noise: a random rotation
 whose rotation vector is N(0, sigma^2) per axis, applied in the body frame.
 
+Quantisation (``resolution`` r > 0, rad/s per count, Gazebo's ``precision``
+of ``gaussian_quantized``): the reading is rounded to the nearest multiple of
+r, which adds r^2 / 12 of variance per sample that the Imu covariance (N^2 *
+rate) does not include, and makes readings of a still gyro exact multiples of r.
+
 A perfect gyro (every parameter 0) returns the truth exactly and draws
 nothing. The same seed and parameters give the same stream, bit for bit,
 whether it is drawn sample by sample (:meth:`GyroModel.measure`) or in
@@ -44,7 +49,8 @@ class GyroErrors:
     ``noise_density`` N (rad/s/sqrt(Hz)); ``bias_random_walk`` K
     (rad/s^2/sqrt(Hz)); ``turn_on_bias`` stddev of b[0] (rad/s);
     ``correlation_time`` tau (s, 0 = a pure random walk); ``orientation_noise``
-    stddev (rad) of the rotation applied to the reported orientation.
+    stddev (rad) of the rotation applied to the reported orientation;
+    ``resolution`` (rad/s per count, 0 = no quantisation).
     """
 
     noise_density: float = 0.0
@@ -52,11 +58,12 @@ class GyroErrors:
     turn_on_bias: float = 0.0
     correlation_time: float = 0.0
     orientation_noise: float = 0.0
+    resolution: float = 0.0
 
     def __post_init__(self):
         """Refuse negative or non-finite values, naming the parameter."""
         for name in ('noise_density', 'bias_random_walk', 'turn_on_bias', 'correlation_time',
-                     'orientation_noise'):
+                     'orientation_noise', 'resolution'):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0):
                 raise ValueError(f'{name} must be a finite number >= 0, got {value!r}')
@@ -122,7 +129,7 @@ class GyroModel:
         n = omega.shape[0]
         if self._perfect:       # no draws: the truth plus the constant turn-on bias (or 0)
             bias = np.repeat(self.bias[None, :], n, axis=0)
-            return omega + bias, bias
+            return self._quantise(omega + bias), bias
         draws = self._rng.standard_normal((n, 2, 3))
         phi, walk = self._phi, self._walk
         if phi == 1.0:      # a random walk: b[k] = ((b[0] + s w[0]) + s w[1]) ..., in order
@@ -135,7 +142,11 @@ class GyroModel:
                 bias[k] = b
                 b = phi * b + walk * draws[k, 1]
             self.bias = b
-        return omega + bias + self._white * draws[:, 0], bias
+        return self._quantise(omega + bias + self._white * draws[:, 0]), bias
+
+    def _quantise(self, rates):
+        r = self.errors.resolution
+        return np.round(rates / r) * r if r else rates
 
     def read(self, q, omega):
         """
