@@ -86,7 +86,8 @@ def test_clipping_rejection_and_forces_are_counted_and_leave_the_state():
     assert body.command_held.vector == (0.2, -0.1, -0.2)
     body.reject('rejected_frame')
     assert body.health()['counts'] == {'accepted': 1, 'rejected_non_finite': 1,
-                                       'rejected_frame': 1, 'clipped': 1, 'force_ignored': 1}
+                                       'rejected_frame': 1, 'clipped': 1, 'force_ignored': 1,
+                                       'stale': 0}
 
 
 def test_world_command_stays_fixed_in_the_world():
@@ -180,3 +181,85 @@ def test_torque_free_steps_stay_exact():
             body.advance(0, outbox)
     q, w = FreeRigidBody((1.0, 2.0, 3.0), (0.3, 1.5, -0.4)).state_at(5.0)
     assert float(quaternions.angle_between(outbox[-1].q, q)) < 1e-13
+
+
+def test_lockstep_waits_for_each_tick_and_holds_from_it():
+    """10 steps per tick: the state at t_k goes out, a command stamped >= t_k releases the tick."""
+    from rigid_body_dynamics.engine import Lockstep
+    clock = FakeClock()
+    body = make_body(publish_every=5, torque_timeout=0.0)
+    lock = Lockstep(body, control_every=10, timeout=0.2, clock=clock, perf=clock.perf)
+    outbox = []
+    assert lock.due(outbox) == 0.0 and outbox == [] and body.steps == 0   # waiting, no timeout
+    clock.advance(int(1.5e9))
+    lock.due(outbox)
+    assert [s.stamp_ns for s in outbox] == [0]                # t_0 again for a late controller
+    assert lock.command((0.1, 0.0, 0.0), False, clock(), stamp_ns=0) == ['accepted']
+    assert lock.arrived.is_set()
+    outbox.clear()
+    lock.due(outbox)
+    assert body.steps == 10 and [s.stamp_ns for s in outbox] == [5 * MS, 10 * MS]
+    assert lock.ticks == 1 and lock.misses == 0
+    lock.due(outbox)
+    assert body.steps == 10                                   # the held command is for t_0
+    assert lock.command((0.2, 0.0, 0.0), False, clock(), stamp_ns=5 * MS) == ['stale']
+    assert body.counts['stale'] == 1 and body.command_held.vector == (0.1, 0.0, 0.0)
+    lock.command((0.2, 0.0, 0.0), False, clock(), stamp_ns=10 * MS)
+    lock.due(outbox)
+    assert body.steps == 20
+    # the same commands offline: a body stepped with 0.1 for 10 steps, then 0.2 for 10
+    ref = make_integrator('exact', (1.0, 2.0, 3.0), 1e-3, (0.0, 0.0, 0.0, 1.0), (0.3, 1.5, -0.4))
+    for torque in [(0.1, 0.0, 0.0)] * 10 + [(0.2, 0.0, 0.0)] * 10:
+        ref.step(torque)
+    assert body.stepper.q == ref.q and body.stepper.omega == ref.omega
+    # no answer within the timeout: a miss, noted once, the last command held
+    clock.advance(int(0.25e9))
+    lock.due(outbox)
+    clock.advance(int(0.25e9))
+    lock.due(outbox)
+    assert body.steps == 40 and lock.misses == 2 and body.command_held.vector == (0.2, 0.0, 0.0)
+    assert len([n for n in body.take_notes() if 'lockstep: no torque_cmd' in n]) == 1
+    lock.command((0.0, 0.0, 0.0), False, clock(), stamp_ns=40 * MS)
+    lock.due(outbox)
+    assert body.steps == 50 and any('answered again after 2' in n for n in body.take_notes())
+    mean, worst = lock.take_wait()
+    assert worst >= mean >= 0.0
+    body.set_paused(True)
+    assert lock.due(outbox) == pacer.PAUSED_WAIT and body.steps == 50
+
+
+def test_lockstep_publishes_the_tick_state_when_it_is_not_a_publish_tick():
+    from rigid_body_dynamics.engine import Lockstep
+    clock = FakeClock()
+    body = make_body(publish_every=7, torque_timeout=0.0)
+    lock = Lockstep(body, control_every=10, timeout=0.0, clock=clock, perf=clock.perf)
+    outbox = []
+    lock.command((0.0, 0.0, 0.0), False, clock(), stamp_ns=0)
+    lock.due(outbox)
+    assert [s.stamp_ns for s in outbox] == [7 * MS, 10 * MS]
+
+
+def test_disturbances_are_summed_into_the_integrated_and_reported_torque():
+    """Constant body and world disturbances and the gravity gradient, against the integrator."""
+    from rigid_body_dynamics.engine import Disturbances
+    from rigid_body_dynamics.physics.disturbances import GravityGradient
+    d = Disturbances(body=(0.01, 0.0, 0.0), world=(0.0, 0.0, 0.02), orbit_rate=0.05,
+                     orbit_normal=(0.0, 0.0, 1.0), nadir0=(1.0, 0.0, 0.0))
+    body, outbox = make_body(disturbances=d, publish_every=50), []
+    body.command((0.0, 0.1, 0.0), False, now_ns=0)
+    with body.lock:
+        for _ in range(100):
+            body.advance(now_ns=0, outbox=outbox)
+    gg = GravityGradient((1.0, 2.0, 3.0), 0.05, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+    ref = make_integrator('exact', (1.0, 2.0, 3.0), 1e-3, (0.0, 0.0, 0.0, 1.0), (0.3, 1.5, -0.4))
+    for _ in range(100):
+        ref.step((0.01, 0.1, 0.0), (0.0, 0.0, 0.02), gg)
+    assert body.stepper.q == ref.q and body.stepper.omega == ref.omega
+    q = ref.q
+    world = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), (0.0, 0.0, 0.02))
+    expected = np.array((0.01, 0.1, 0.0)) + world + gg(0.1, *q)
+    np.testing.assert_allclose(outbox[-1].torque, expected, rtol=0, atol=1e-17)
+    # an integrator change mid-run keeps the orbit's clock (the field's epoch)
+    with body.lock:
+        body.configure(integrator='rk4')
+        assert body._field.epoch == pytest.approx(0.1)

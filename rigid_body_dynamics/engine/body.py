@@ -11,7 +11,9 @@ time is an integer step count times dt, and snapshots carry the stamp
 Frames: the body frame is the user's (the inertia's); the state is kept in
 the principal frame of the inertia. Torques in N m, body frame, or world frame
 for a command given in the world frame (rotated into the body at every RK
-stage by the integrator).
+stage by the integrator). :class:`Disturbances` are summed into the torque
+that is integrated (and reported in snapshots), the gravity gradient
+evaluated at every RK stage.
 """
 
 from dataclasses import dataclass
@@ -21,13 +23,15 @@ import threading
 import numpy as np
 
 from ..physics import make_integrator, quaternions
+from ..physics.disturbances import GravityGradient
 from ..physics.sensors import GyroErrors, GyroModel
 
 _ZERO = (0.0, 0.0, 0.0)
 _NS = 1_000_000_000
 
 #: Counters of torque commands, in the order diagnostics list them.
-COUNTS = ('accepted', 'rejected_non_finite', 'rejected_frame', 'clipped', 'force_ignored')
+COUNTS = ('accepted', 'rejected_non_finite', 'rejected_frame', 'clipped', 'force_ignored',
+          'stale')
 
 
 @dataclass(frozen=True)
@@ -38,6 +42,31 @@ class TorqueCommand:
     world: bool
     received_ns: int
     principal: object   # the body vector in the principal frame (None for a world command)
+    stamp_ns: object = None   # the command's header stamp (int ns), if it has one
+
+
+@dataclass(frozen=True)
+class Disturbances:
+    """
+    Disturbance torques, summed into the commanded torque (N m).
+
+    ``body``: constant in the body frame; ``world``: constant in the world
+    frame; ``orbit_rate`` n (rad/s, 0 = none): the gravity gradient of a
+    circular orbit about the world unit vector ``orbit_normal`` with nadir
+    along ``nadir0`` (world) at simulated time 0
+    (:class:`~rigid_body_dynamics.physics.disturbances.GravityGradient`).
+    """
+
+    body: tuple = _ZERO
+    world: tuple = _ZERO
+    orbit_rate: float = 0.0
+    orbit_normal: tuple = (0.0, 0.0, 1.0)
+    nadir0: tuple = (1.0, 0.0, 0.0)
+
+    @property
+    def any(self):
+        """Whether any disturbance acts."""
+        return bool(any(self.body) or any(self.world) or self.orbit_rate)
 
 
 @dataclass(frozen=True)
@@ -86,13 +115,15 @@ class BodySimulation:
     frame, ``torque_timeout`` (s; 0 = hold forever), ``max_torque`` (N m per
     axis; 0 = no limit), ``publish_every`` (steps per publish tick), ``imu_every``
     (steps per gyro sample, 0 = none), ``gyro`` (GyroErrors; None = perfect) and
-    its ``seed``, ``start_ns`` (stamp of simulated time 0). ``lock`` guards every change;
+    its ``seed``, ``start_ns`` (stamp of simulated time 0), ``disturbances``
+    (:class:`Disturbances`; None = none). ``lock`` guards every change;
     the methods take it themselves. ``notes`` collects what a node should
     log (the watchdog's timeouts), drained with :meth:`take_notes`.
     """
 
     def __init__(self, inertia, integrator, rate, initial, torque_timeout=0.5, max_torque=0.0,
-                 publish_every=1, start_ns=0, imu_every=0, gyro=None, seed=0):
+                 publish_every=1, start_ns=0, imu_every=0, gyro=None, seed=0,
+                 disturbances=None):
         self.lock = threading.RLock()
         self.rate = float(rate)
         self.dt = 1.0 / self.rate
@@ -107,6 +138,7 @@ class BodySimulation:
         self.imu_every = int(imu_every)       # steps per gyro sample; 0 = no IMU
         self.gyro_errors = gyro if gyro is not None else GyroErrors()
         self.seed = int(seed)
+        self.disturbances = disturbances or Disturbances()
         self.counts = dict.fromkeys(COUNTS, 0)
         self.notes = []
         self.reset()
@@ -127,7 +159,19 @@ class BodySimulation:
             self.last_torque = _ZERO
             self.gyro = GyroModel(self.gyro_errors, self.rate / max(self.imu_every, 1),
                                   self.seed)     # same seed: the same stream after a reset
+            self._disturb()
             self._baseline()
+
+    def _disturb(self):
+        """Set up the disturbances for the current inertia and stepper (call under lock)."""
+        d, body = self.disturbances, self.inertia
+        self._dist_body = tuple(float(c) for c in body.to_principal(np.array(d.body))) \
+            if any(d.body) else None
+        self._dist_world = tuple(float(c) for c in d.world) if any(d.world) else None
+        # the stepper's time starts at 0 when it is made: the field is told the offset
+        self._field = GravityGradient(body.moments, d.orbit_rate, d.orbit_normal, d.nadir0,
+                                      epoch=(self.steps - self.stepper.steps) * self.dt) \
+            if d.orbit_rate else None
 
     def _baseline(self):
         """Remember T and L_w now: drift is reported since the last torque or change."""
@@ -152,7 +196,7 @@ class BodySimulation:
 
     # ------------------------------------------------------------------ configuration
     def configure(self, inertia=None, integrator=None, initial=None, torque_timeout=None,
-                  max_torque=None, publish_every=None):
+                  max_torque=None, publish_every=None, disturbances=None):
         """
         Take validated settings into effect; returns lines saying what changed.
 
@@ -170,6 +214,11 @@ class BodySimulation:
                 self.max_torque = float(max_torque)
             if publish_every is not None:
                 self.publish_every = int(publish_every)
+            if disturbances is not None and disturbances != self.disturbances:
+                self.disturbances = disturbances
+                self._disturb()
+                self._base_stale = True
+                lines.append(f'disturbances now {disturbances}')
             rebuild = False
             if inertia is not None and inertia is not self.inertia:
                 q_b, w_b = self.body_state()
@@ -185,22 +234,26 @@ class BodySimulation:
             if rebuild:
                 self.stepper = make_integrator(self.integrator_name, self.inertia.moments,
                                                self.dt, self.stepper.q, self.stepper.omega)
+                self._disturb()
                 self._baseline()
                 cmd = self.command_held
                 if cmd is not None:
                     self.command_held = self._make_command(cmd.vector, cmd.world,
-                                                           cmd.received_ns)
+                                                           cmd.received_ns, cmd.stamp_ns)
         return lines
 
     # ------------------------------------------------------------------ torque
-    def _make_command(self, vector, world, received_ns):
+    def _make_command(self, vector, world, received_ns, stamp_ns=None):
         principal = None if world else tuple(
             float(c) for c in self.inertia.to_principal(np.array(vector)))
-        return TorqueCommand(tuple(vector), world, received_ns, principal)
+        return TorqueCommand(tuple(vector), world, received_ns, principal, stamp_ns)
 
-    def command(self, vector, world, now_ns, force=_ZERO):
+    def command(self, vector, world, now_ns, force=_ZERO, stamp_ns=None):
         """
         Hold a new torque: N m in the body frame, or in the world frame if ``world``.
+
+        ``stamp_ns``: the command's header stamp (int ns), kept with it (lockstep
+        waits for a command stamped at or after the current tick).
 
         A non-finite torque is refused and counted (returns 'rejected_non_finite',
         the state untouched); a component beyond ``max_torque`` is clipped and
@@ -222,7 +275,7 @@ class BodySimulation:
             events.append('accepted')
             for event in events:
                 self.counts[event] += 1
-            self.command_held = self._make_command(vector, bool(world), int(now_ns))
+            self.command_held = self._make_command(vector, bool(world), int(now_ns), stamp_ns)
             return events
 
     def reject(self, reason):
@@ -261,14 +314,25 @@ class BodySimulation:
     def advance(self, now_ns, outbox):
         """One integration step (call under ``lock``); a publish tick's snapshot goes to outbox."""
         torque, torque_world = self.torque_now(now_ns)
-        torqued = torque_world is not None or torque[0] or torque[1] or torque[2]
+        if self._dist_body is not None:
+            torque = tuple(a + b for a, b in zip(torque, self._dist_body))
+        if self._dist_world is not None:
+            torque_world = self._dist_world if torque_world is None else tuple(
+                a + b for a, b in zip(torque_world, self._dist_world))
+        field = self._field
+        torqued = (field is not None or torque_world is not None or torque[0] or torque[1]
+                   or torque[2])
         if self._base_stale and not torqued:
             self._baseline()          # the state after the last step under torque
-        self.stepper.step(torque, torque_world)
+        self.stepper.step(torque, torque_world, field)
         self.steps += 1
+        q = self.stepper.q
         if torque_world is not None:
-            q = self.stepper.q
-            torque = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), torque_world)
+            w = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), torque_world)
+            torque = (torque[0] + w[0], torque[1] + w[1], torque[2] + w[2])
+        if field is not None:      # the field's torque at the end of the step
+            f = field(self.stepper.time, *q)
+            torque = (torque[0] + f[0], torque[1] + f[1], torque[2] + f[2])
         self._base_stale = self._base_stale or bool(torqued)
         self.last_torque = torque
         if self.steps % self.publish_every == 0:
@@ -287,15 +351,19 @@ class BodySimulation:
         """Sample the gyro at the current state (call under ``lock``): an :class:`ImuSample`."""
         gyro = self.gyro
         q, measured, bias = gyro.read(*self.body_state())
-        return ImuSample(self.start_ns + int(self.steps * self.dt_ns),
+        return ImuSample(self.stamp_now(),
                          tuple(float(c) for c in q),
                          tuple(float(c) for c in measured), tuple(float(c) for c in bias),
                          gyro.rate_variance, gyro.orientation_variance)
 
+    def stamp_now(self):
+        """Return the stamp (int ns) of the current simulated time."""
+        return self.start_ns + int(self.steps * self.dt_ns)
+
     def snapshot(self):
         """Take the current :class:`Snapshot` (call under ``lock``)."""
         s = self.stepper
-        return Snapshot(self.start_ns + int(self.steps * self.dt_ns), self.steps, s.q, s.omega,
+        return Snapshot(self.stamp_now(), self.steps, s.q, s.omega,
                         self.last_torque, self.inertia)
 
     # ------------------------------------------------------------------ diagnostics

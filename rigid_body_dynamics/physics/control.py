@@ -10,6 +10,83 @@ omega (rad/s, body frame), torque (N m, body frame) as a 3-tuple. In
 import math
 
 
+def _saturate(tau, limit):
+    """Scale the vector tau down to |tau| = limit (N m) if longer; limit 0 = none."""
+    size = math.sqrt(tau[0] ** 2 + tau[1] ** 2 + tau[2] ** 2)
+    if limit > 0.0 and size > limit:
+        scale = limit / size
+        return (tau[0] * scale, tau[1] * scale, tau[2] * scale)
+    return tau
+
+
+def _check_moments(moments):
+    moments = tuple(float(i) for i in moments)
+    if len(moments) != 3 or not all(i > 0.0 and math.isfinite(i) for i in moments):
+        raise ValueError(f'moments must be three positive numbers, got {moments}')
+    return moments
+
+
+def settling_time(natural_frequency, damping_ratio, band=0.02):
+    """
+    Settling time (s) of the small-angle PD slew: the last time |theta| = band theta0.
+
+    Each axis of :class:`QuaternionPD` linearises to theta'' + 2 zeta wn
+    theta' + wn^2 theta = 0 (theta the error angle, from rest at theta0);
+    this is the last exit of that response from the band, found on its
+    closed form (0 < zeta < 1: theta0 e^(-zeta wn t) (cos wd t + zeta wn / wd
+    sin wd t), wd = wn sqrt(1 - zeta^2); zeta >= 1: the critically or over-
+    damped form). Near the envelope estimate -ln(band) / (zeta wn) but exact.
+    """
+    from scipy.optimize import brentq
+    wn, zeta = float(natural_frequency), float(damping_ratio)
+    if not (wn > 0.0 and zeta > 0.0 and 0.0 < band < 1.0):
+        raise ValueError('natural_frequency and damping_ratio must be > 0, band in (0, 1)')
+    if zeta < 1.0:
+        wd = wn * math.sqrt(1.0 - zeta * zeta)
+
+        def theta(t):
+            return math.exp(-zeta * wn * t) * (math.cos(wd * t) + zeta * wn / wd * math.sin(wd * t))
+    elif zeta == 1.0:
+        def theta(t):
+            return math.exp(-wn * t) * (1.0 + wn * t)
+    else:
+        r1 = -wn * (zeta - math.sqrt(zeta * zeta - 1.0))
+        r2 = -wn * (zeta + math.sqrt(zeta * zeta - 1.0))
+
+        def theta(t):
+            return (r2 * math.exp(r1 * t) - r1 * math.exp(r2 * t)) / (r2 - r1)
+    # past the envelope's bound the response stays inside; scan back to its last exit
+    end = -math.log(band * 1e-3) / (zeta * wn) if zeta < 1.0 else \
+        -math.log(band * 1e-3) / (wn * (zeta - math.sqrt(max(zeta * zeta - 1.0, 0.0))))
+    grid = [end * k / 20000.0 for k in range(20001)]
+    outside = [abs(theta(t)) - band for t in grid]
+    last = max(k for k, v in enumerate(outside) if v > 0.0)
+    sign = 1.0 if theta(grid[last]) > 0.0 else -1.0
+    return brentq(lambda t: sign * theta(t) - band, grid[last], grid[last + 1], xtol=1e-14)
+
+
+class RateDamper:
+    """
+    Detumbling: tau_i = -kd_i omega_i, kd_i = 2 zeta wn I_i, vector-saturated at max_torque.
+
+    Each axis' rate decays as exp(-2 zeta wn t) until the torque saturates;
+    the same gains as :class:`QuaternionPD` without the attitude term.
+    """
+
+    def __init__(self, moments, natural_frequency, damping_ratio, max_torque=0.0):
+        moments = _check_moments(moments)
+        if not (natural_frequency > 0.0 and damping_ratio > 0.0 and max_torque >= 0.0):
+            raise ValueError('natural_frequency and damping_ratio must be > 0, max_torque >= 0')
+        self.kd = tuple(2.0 * damping_ratio * natural_frequency * i for i in moments)
+        self.max_torque = float(max_torque)
+
+    def __call__(self, q, omega):
+        """Body torque (N m) for body rate omega (rad/s); q is not used."""
+        d1, d2, d3 = self.kd
+        w1, w2, w3 = (float(c) for c in omega)
+        return _saturate((-d1 * w1, -d2 * w2, -d3 * w3), self.max_torque)
+
+
 class QuaternionPD:
     """
     Quaternion-feedback PD to a fixed target attitude, vector-saturated.
@@ -24,9 +101,7 @@ class QuaternionPD:
     """
 
     def __init__(self, moments, target, natural_frequency, damping_ratio, max_torque=0.0):
-        moments = tuple(float(i) for i in moments)
-        if len(moments) != 3 or not all(i > 0.0 and math.isfinite(i) for i in moments):
-            raise ValueError(f'moments must be three positive numbers, got {moments}')
+        moments = _check_moments(moments)
         norm = math.sqrt(sum(float(c) ** 2 for c in target))
         if not (norm > 0.0 and math.isfinite(norm)):
             raise ValueError(f'target must be a finite non-zero quaternion, got {target}')
@@ -48,9 +123,5 @@ class QuaternionPD:
         sign = 1.0 if tw * s + tx * x + ty * y + tz * z >= 0.0 else -1.0
         (p1, p2, p3), (d1, d2, d3) = self.kp, self.kd
         w1, w2, w3 = (float(c) for c in omega)
-        tau = (-p1 * sign * ex - d1 * w1, -p2 * sign * ey - d2 * w2, -p3 * sign * ez - d3 * w3)
-        size = math.sqrt(tau[0] ** 2 + tau[1] ** 2 + tau[2] ** 2)
-        if self.max_torque > 0.0 and size > self.max_torque:
-            scale = self.max_torque / size
-            tau = (tau[0] * scale, tau[1] * scale, tau[2] * scale)
-        return tau
+        return _saturate((-p1 * sign * ex - d1 * w1, -p2 * sign * ey - d2 * w2,
+                          -p3 * sign * ez - d3 * w3), self.max_torque)

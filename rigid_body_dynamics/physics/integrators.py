@@ -41,6 +41,8 @@ from .free_motion import BodyShape
 from .quaternions import rotate_components
 from .rk_kernels import KERNELS
 
+_ZERO = (0.0, 0.0, 0.0)
+
 #: Integrators that existed and were removed, with what to use instead.
 REMOVED = {
     'exact4': 'exact4 (Yoshida splitting) was removed: `exact` is now order 6-8 under '
@@ -156,11 +158,15 @@ class Integrator(ABC):
         """1/2 omega . I omega (J)."""
         return 0.5 * sum(i * w * w for i, w in zip(self.moments, self.omega))
 
-    def step(self, torque=(0.0, 0.0, 0.0), torque_world=None):
+    def step(self, torque=(0.0, 0.0, 0.0), torque_world=None, field=None):
         """
         Advance by one step dt, the torque held in the body frame over it (N m).
 
         ``torque_world`` (N m), if not None, is held fixed in the world frame.
+        ``field``, if not None, adds a torque that depends on time and attitude,
+        ``field(t, qx, qy, qz, qw)`` -> principal-frame torque (N m) with t the
+        simulated time (s) and q principal -> world: the method evaluates it at
+        its stages (e.g. :class:`~rigid_body_dynamics.physics.disturbances.GravityGradient`).
         A torque that is not three finite numbers raises ValueError and
         leaves the state as it was.
         """
@@ -169,12 +175,13 @@ class Integrator(ABC):
             torque_world = _as_torque(torque_world, 'torque_world')
             if not (torque_world[0] or torque_world[1] or torque_world[2]):
                 torque_world = None
-        if torque_world is None and not (torque[0] or torque[1] or torque[2]):
+        if field is None and torque_world is None and not (torque[0] or torque[1] or torque[2]):
             self._lw = None
             self._free_step()
         else:
             before = self._lw or self.angular_momentum_world
-            work = self._torque_step(torque, torque_world)
+            work = (self._torque_step(torque, torque_world) if field is None else
+                    self._field_step(torque, torque_world or _ZERO, field))
             self._work = _neumaier(*self._work, work)
             after = self._lw = self.angular_momentum_world
             self._impulse = [_neumaier(*acc, a - b)
@@ -189,6 +196,10 @@ class Integrator(ABC):
     def _torque_step(self, torque, torque_world):
         """Advance self.q, self.omega by dt under the held torque; return the work (J)."""
 
+    @abstractmethod
+    def _field_step(self, torque, torque_world, field):
+        """Advance by dt under the held torques plus ``field``; return the work (J)."""
+
 
 class RK4Integrator(Integrator):
     """Classic fixed-step RK4 on (omega, q), q renormalised each step; order 4."""
@@ -201,10 +212,17 @@ class RK4Integrator(Integrator):
     def _free_step(self):
         self.q, self.omega, _ = self._free(self._inv, self.q, self.omega, self.dt, None, None)
 
+    _field = staticmethod(KERNELS[(4, 'field')])
+
     def _torque_step(self, torque, torque_world):
         kernel = self._body if torque_world is None else self._world
         self.q, self.omega, work = kernel(self._inv, self.q, self.omega, self.dt, torque,
                                           torque_world)
+        return work
+
+    def _field_step(self, torque, torque_world, field):
+        self.q, self.omega, work = self._field(self._inv, self.q, self.omega, self.dt, torque,
+                                               torque_world, field, self.time)
         return work
 
 
@@ -240,7 +258,7 @@ class ExactIntegrator(Integrator):
     ORDER6_LIMIT = 0.01
     ORDER8_LIMIT = 0.08
     _kernels = {mode: (KERNELS[(6, mode)], KERNELS[(8, mode)])
-                for mode in ('free', 'body', 'world')}
+                for mode in ('free', 'body', 'world', 'field')}
 
     def _reset(self):
         if not hasattr(self, '_shape'):
@@ -280,25 +298,36 @@ class ExactIntegrator(Integrator):
         return self._rk('body' if torque_world is None else 'world', torque, torque_world,
                         self._torque_rate)
 
-    def _rk(self, mode, torque, torque_world, torque_rate):
+    def _field_step(self, torque, torque_world, field):
+        self._segment = None
+        t = self.time
+        f = field(t, *self.q)
+        largest = (max(abs(torque[0] + f[0]), abs(torque[1] + f[1]), abs(torque[2] + f[2]))
+                   + max(abs(torque_world[0]), abs(torque_world[1]), abs(torque_world[2])))
+        return self._rk('field', torque, torque_world, math.sqrt(largest / self._i_min),
+                        field)
+
+    def _rk(self, mode, torque, torque_world, torque_rate, field=None):
         """
         Advance by dt with the order-6 or order-8 kernel of ``mode``; return the work (J).
 
-        ``torque_rate`` (1/s) is the torque's part of rho, sqrt(max |tau_i| / I_min).
+        ``torque_rate`` (1/s) is the torque's part of rho, sqrt(max |tau_i| / I_min);
+        ``field`` the time- and attitude-dependent torque of mode ``field``.
         """
         wx, wy, wz = self.omega
+        t = self.time
         spare = self._order6_rate - torque_rate     # what |omega| may be for order 6
         if spare > 0.0 and wx * wx + wy * wy + wz * wz <= spare * spare:
             self.q, self.omega, work = self._kernels[mode][0](
-                self._inv, self.q, self.omega, self.dt, torque, torque_world)
+                self._inv, self.q, self.omega, self.dt, torque, torque_world, field, t)
             return work
         rho = math.sqrt(wx * wx + wy * wy + wz * wz) + torque_rate
         n = max(1, math.ceil(rho * self.dt / self.ORDER8_LIMIT))
         h = self.dt / n
         order8 = self._kernels[mode][1]
         q, w, work = self.q, self.omega, 0.0
-        for _ in range(n):
-            q, w, dw = order8(self._inv, q, w, h, torque, torque_world)
+        for k in range(n):
+            q, w, dw = order8(self._inv, q, w, h, torque, torque_world, field, t + k * h)
             work += dw
         self.q, self.omega = q, w
         return work

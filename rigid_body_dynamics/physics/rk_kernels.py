@@ -16,14 +16,17 @@ generates its class) and compiled once at import. The tableaux:
   its coefficients taken from scipy (``scipy.integrate._ivp.dop853_coefficients``),
   without the error estimator or dense output.
 
-Each kernel is ``step(inv, q, w, h, tau, tau_world)`` with ``inv`` = (c1, c2,
-c3, 1/I1, 1/I2, 1/I3), c1 = (I2 - I3) / I1 and cyclic, ``tau`` the body torque
-(N m) and ``tau_world`` the world torque (N m) held fixed in the world frame
-(rotated into the body at every stage). It returns (q, omega, work): q
-renormalised, and the step's work int omega . tau dt (J) by the method's own
-quadrature of the stage values, so it is accurate to the method's order.
-Three variants: ``free`` (no torque; work 0), ``body`` (tau only) and
-``world`` (tau plus tau_world).
+Each kernel is ``step(inv, q, w, h, tau, tau_world, field=None, t=0.0)`` with
+``inv`` = (c1, c2, c3, 1/I1, 1/I2, 1/I3), c1 = (I2 - I3) / I1 and cyclic,
+``tau`` the body torque (N m) and ``tau_world`` the world torque (N m) held
+fixed in the world frame (rotated into the body at every stage). It returns
+(q, omega, work): q renormalised, and the step's work int omega . tau dt (J)
+by the method's own quadrature of the stage values, so it is accurate to the
+method's order. Four variants: ``free`` (no torque; work 0), ``body`` (tau
+only), ``world`` (tau plus tau_world) and ``field`` (tau plus tau_world plus
+a torque that depends on time and attitude, ``field(t_stage, qx, qy, qz, qw)``
+-> body torque (N m), evaluated at every stage at t_stage = t + c_i h, so a
+gravity-gradient torque is integrated to the method's order, not held).
 """
 
 from fractions import Fraction as F
@@ -46,10 +49,12 @@ BUTCHER6 = (
     (F(11, 120), F(0), F(27, 40), F(27, 40), F(-4, 15), F(-4, 15), F(11, 120)),
 )
 
-#: DOP853's order-8 tableau (12 stages) as floats.
+#: DOP853's order-8 tableau (12 stages) as floats, with its nodes c (the float rows of A
+#: sum to them only within round-off).
 DOP853 = (
     tuple(tuple(float(a) for a in _dop.A[i, :i]) for i in range(_dop.N_STAGES)),
     tuple(float(b) for b in _dop.B),
+    tuple(float(c) for c in _dop.C[:_dop.N_STAGES]),
 )
 
 _OMEGA = ('wx', 'wy', 'wz')
@@ -60,19 +65,22 @@ def _lit(coefficient):
     return repr(float(coefficient))
 
 
-def _derivative_lines(i, mode):
-    """Scaled derivatives h f(stage i): dwx{i} ... dqw{i}, and the stage torque."""
+def _derivative_lines(i, mode, node):
+    """Scaled derivatives h f(stage i at time node c_i): dwx{i} ... dqw{i}, the torque."""
     wx, wy, wz, qx, qy, qz, qw = (f'{n}{i}' for n in _OMEGA + _QUAT)
+    fx, fy, fz = (' + fx', ' + fy', ' + fz') if mode == 'field' else ('', '', '')
     lines = []
-    if mode == 'world':
+    if mode == 'field':
+        lines.append(f'    fx, fy, fz = field(t + {_lit(node)} * h, {qx}, {qy}, {qz}, {qw})')
+    if mode in ('world', 'field'):
         # tau_b = tau + R(q)^T tau_world: rotate by the conjugate (-qx, -qy, -qz, qw)
         lines += [
             f'    ux = 2.0 * (-{qy} * gz + {qz} * gy)',
             f'    uy = 2.0 * (-{qz} * gx + {qx} * gz)',
             f'    uz = 2.0 * (-{qx} * gy + {qy} * gx)',
-            f'    tx{i} = tbx + gx + {qw} * ux - {qy} * uz + {qz} * uy',
-            f'    ty{i} = tby + gy + {qw} * uy - {qz} * ux + {qx} * uz',
-            f'    tz{i} = tbz + gz + {qw} * uz - {qx} * uy + {qy} * ux',
+            f'    tx{i} = tbx{fx} + gx + {qw} * ux - {qy} * uz + {qz} * uy',
+            f'    ty{i} = tby{fy} + gy + {qw} * uy - {qz} * ux + {qx} * uz',
+            f'    tz{i} = tbz{fz} + gz + {qw} * uz - {qx} * uy + {qy} * ux',
             f'    dwx{i} = hc1 * {wy} * {wz} + hj1 * tx{i}',
             f'    dwy{i} = hc2 * {wz} * {wx} + hj2 * ty{i}',
             f'    dwz{i} = hc3 * {wx} * {wy} + hj3 * tz{i}',
@@ -95,9 +103,10 @@ def _derivative_lines(i, mode):
 
 
 def kernel_source(tableau, mode, name='step'):
-    """Python source of one unrolled step for ``tableau`` = (A rows, b) and ``mode``."""
-    rows, weights = tableau
-    lines = [f'def {name}(inv, q, w, h, tau, tau_world):',
+    """Python source of one unrolled step for ``tableau`` = (A rows, b[, c]) and ``mode``."""
+    rows, weights = tableau[:2]
+    nodes = tableau[2] if len(tableau) > 2 else [sum(row) for row in rows]
+    lines = [f'def {name}(inv, q, w, h, tau, tau_world, field=None, t=0.0):',
              '    c1, c2, c3, j1, j2, j3 = inv',
              '    qx0, qy0, qz0, qw0 = q',
              '    wx0, wy0, wz0 = w',
@@ -106,7 +115,7 @@ def kernel_source(tableau, mode, name='step'):
     if mode == 'body':
         lines += ['    tbx, tby, tbz = tau',
                   '    ht1, ht2, ht3 = h * tbx * j1, h * tby * j2, h * tbz * j3']
-    elif mode == 'world':
+    elif mode in ('world', 'field'):
         lines += ['    tbx, tby, tbz = tau',
                   '    gx, gy, gz = tau_world',
                   '    hj1, hj2, hj3 = h * j1, h * j2, h * j3']
@@ -116,7 +125,7 @@ def kernel_source(tableau, mode, name='step'):
                 terms = ' + '.join(f'{_lit(a)} * d{var}{j}' for j, a in enumerate(row) if a != 0)
                 lines.append(f'    {var}{i} = {var}0 + {terms}' if terms else
                              f'    {var}{i} = {var}0')
-        lines += _derivative_lines(i, mode)
+        lines += _derivative_lines(i, mode, nodes[i])
     used = [(j, b) for j, b in enumerate(weights) if b != 0]
     for var in _OMEGA + _QUAT:
         terms = ' + '.join(f'{_lit(b)} * d{var}{j}' for j, b in used)
@@ -147,4 +156,4 @@ def compile_kernel(tableau, mode):
 #: Kernels by (order, mode).
 KERNELS = {(order, mode): compile_kernel(tableau, mode)
            for order, tableau in ((4, RK4), (6, BUTCHER6), (8, DOP853))
-           for mode in ('free', 'body', 'world')}
+           for mode in ('free', 'body', 'world', 'field')}

@@ -1,0 +1,140 @@
+"""
+Lockstep: the body waits for its controller at every control tick (no ROS, no wall pacing).
+
+At each control tick t_k (every ``control_every`` integration steps from 0) the
+state at t_k goes out, then the body waits until a torque command stamped at
+or after t_k has arrived; that command is held from t_k on (zero-order hold)
+and the body integrates to t_{k+1} as fast as it can. Stamps and state are
+then a function of the commands only: the same controller gives the same
+trajectory, bit for bit, however loaded the machine is.
+
+Before the first command the wait has no limit (the state at t_0 goes out
+again every ``REPEAT`` s, so a late controller finds it). After it, a tick
+whose command does not come within ``timeout`` (wall s; 0 = wait for ever)
+is a miss: counted, noted for the log, and the last command is held. A
+command stamped before the current tick (an answer that came too late) is
+counted as ``stale`` and not used: using it would make the run depend on
+timing. Interface as :class:`~.pacer.Pace` (``due(outbox)`` returns the wall
+time to wait), so the node's integration thread drives either.
+"""
+
+import threading
+import time
+
+from .pacer import Pace, PAUSED_WAIT
+
+_NS = 1_000_000_000
+#: Period (wall s) at which the state at t_0 is published again until the first command.
+REPEAT = 1.0
+#: Longest single wait inside due() (s), so that stopping the thread is prompt.
+WAIT_SLICE = 0.1
+
+
+class Lockstep(Pace):
+    """
+    Lockstep schedule of one body: ``control_every`` steps per tick, ``timeout`` (s).
+
+    Counters: ``ticks`` answered, ``misses``, ``wait_ns`` (total wall time
+    spent waiting for answered ticks) and ``max_wait_ns`` since
+    :meth:`take_wait`.
+    """
+
+    def __init__(self, body, control_every, timeout, clock=time.monotonic_ns,
+                 perf=time.perf_counter):
+        super().__init__(body, 0.0, clock=clock, perf=perf)
+        self.control_every = int(control_every)
+        if self.control_every < 1:
+            raise ValueError(f'control_every must be >= 1, got {control_every!r}')
+        self.timeout_ns = int(timeout * _NS)
+        self.arrived = threading.Event()
+        self.restart()
+
+    def restart(self):
+        """From the body's current tick (after start-up or a reset): waiting, no command yet."""
+        super().restart()
+        self.ticks = self.misses = 0
+        self.wait_ns = self.max_wait_ns = 0
+        self._first = True
+        self._streak = 0
+        self._wait_start = self._last_repeat = self.clock()
+
+    def set_rtf(self, rtf):
+        """Lockstep runs as fast as the controller answers: the real-time factor is unused."""
+
+    def command(self, vector, world, now_ns, stamp_ns, force=(0.0, 0.0, 0.0)):
+        """
+        Take a command stamped ``stamp_ns`` (int ns); returns the body's events.
+
+        Stamped before the current tick: counted ``stale`` and dropped
+        (returns ['stale']). Otherwise as ``BodySimulation.command``, and the
+        waiting tick is woken.
+        """
+        body = self.body
+        with body.lock:
+            if stamp_ns < body.stamp_now():
+                body.counts['stale'] += 1
+                return ['stale']
+            events = body.command(vector, world, now_ns, force=force, stamp_ns=stamp_ns)
+        self.arrived.set()
+        return events
+
+    def due(self, outbox):
+        """
+        Publish the tick's state, or wait for its command, or integrate to the next tick.
+
+        Returns 0.0 (call again at once) or PAUSED_WAIT; waits inside for at most
+        WAIT_SLICE s with the body's lock released.
+        """
+        body = self.body
+        with body.lock:
+            if body.paused:
+                return PAUSED_WAIT
+            now = self.clock()
+            self.arrived.clear()
+            cmd = body.command_held
+            answered = cmd is not None and cmd.stamp_ns is not None and \
+                cmd.stamp_ns >= body.stamp_now()
+            waited = now - self._wait_start
+            if answered or (not self._first and self.timeout_ns and waited > self.timeout_ns):
+                self._close_tick(answered, waited)
+                for _ in range(self.control_every):
+                    body.advance(now, outbox)
+                if body.steps % body.publish_every:
+                    outbox.append(body.snapshot())      # the state at the tick always goes out
+                self._wait_start = self.clock()
+                return 0.0
+            if self._first and now - self._last_repeat >= REPEAT * _NS:
+                self._last_repeat = now
+                outbox.append(body.snapshot())          # for a controller that comes late
+                return 0.0
+            left = (self.timeout_ns - waited) / _NS if self.timeout_ns and not self._first \
+                else WAIT_SLICE
+        self.arrived.wait(min(max(left, 0.0), WAIT_SLICE))
+        return 0.0
+
+    def _close_tick(self, answered, waited):
+        body = self.body
+        if answered:
+            self.ticks += 1
+            self.wait_ns += waited
+            self.max_wait_ns = max(self.max_wait_ns, waited)
+            if self._streak:
+                body.notes.append(f'lockstep: the controller answered again after '
+                                  f'{self._streak} missed ticks')
+            self._first, self._streak = False, 0
+            return
+        self.misses += 1
+        if not self._streak:
+            body.notes.append(
+                f'lockstep: no torque_cmd stamped at or after t = {body.steps * body.dt:.6g} s '
+                f'within {self.timeout_ns / _NS:g} s; holding the last command and going on '
+                '(said once until the controller answers again)')
+        self._streak += 1
+
+    def take_wait(self):
+        """Return (mean, max) wall wait per answered tick (ms) since the last call; start over."""
+        with self.body.lock:
+            mean = self.wait_ns / self.ticks / 1e6 if self.ticks else 0.0
+            result = (mean, self.max_wait_ns / 1e6)
+            self.max_wait_ns = 0
+        return result
