@@ -1,5 +1,9 @@
-"""Disturbance torques (physics/disturbances.py): the gravity gradient against its formula,
-integrated at the stages against DOP853, and the pitch libration of its stable attitude."""
+"""
+Disturbance torques (physics/disturbances.py) against formula, DOP853 and libration theory.
+
+The gravity gradient against its formula, integrated at the RK stages against
+DOP853, and the pitch libration of its stable attitude.
+"""
 
 import math
 

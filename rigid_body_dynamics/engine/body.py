@@ -64,7 +64,7 @@ class Disturbances:
     nadir0: tuple = (1.0, 0.0, 0.0)
 
     @property
-    def any(self):
+    def active(self):
         """Whether any disturbance acts."""
         return bool(any(self.body) or any(self.world) or self.orbit_rate)
 

@@ -45,7 +45,8 @@ def settling_time(natural_frequency, damping_ratio, band=0.02):
         wd = wn * math.sqrt(1.0 - zeta * zeta)
 
         def theta(t):
-            return math.exp(-zeta * wn * t) * (math.cos(wd * t) + zeta * wn / wd * math.sin(wd * t))
+            return math.exp(-zeta * wn * t) * (math.cos(wd * t)
+                                               + zeta * wn / wd * math.sin(wd * t))
     elif zeta == 1.0:
         def theta(t):
             return math.exp(-wn * t) * (1.0 + wn * t)

@@ -69,7 +69,7 @@ class GravityGradient:
         self.epoch = float(epoch)
 
     def nadir_world(self, t):
-        """The unit nadir vector in the world frame at time t (s)."""
+        """Return the unit nadir vector in the world frame at time t (s, without the epoch)."""
         c, s = math.cos(self.n * t), math.sin(self.n * t)
         a, b = self.nadir0, self.along
         return (c * a[0] + s * b[0], c * a[1] + s * b[1], c * a[2] + s * b[2])
