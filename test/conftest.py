@@ -42,29 +42,16 @@ def random_attitude(rng):
 
 
 @pytest.fixture(scope='session', autouse=True)
-def ros_domain(tmp_path_factory):
+def ros_domain(ros_isolation):
     """
     Reserve a free ROS_DOMAIN_ID for this session and keep DDS on this machine.
 
-    Sets the environment that every node process inherits and that this
+    The package's own pytest plugin (rigid_body_dynamics.testing, the fixture
+    users get) sets the environment every node process inherits and that this
     process's rclpy contexts read: ROS_DOMAIN_ID, localhost-only discovery,
     and ROS_LOG_DIR in a temporary folder.
     """
-    from domain_coordinator import domain_id
-    saved = {k: os.environ.get(k) for k in
-             ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_LOG_DIR',
-              'ROS_LOCALHOST_ONLY')}
-    with domain_id() as domain:
-        os.environ['ROS_DOMAIN_ID'] = str(domain)
-        os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-        os.environ['ROS_LOG_DIR'] = str(tmp_path_factory.mktemp('ros_log'))
-        os.environ.pop('ROS_LOCALHOST_ONLY', None)
-        yield domain
-    for key, value in saved.items():
-        if value is None:
-            os.environ.pop(key, None)
-        else:
-            os.environ[key] = value
+    return ros_isolation
 
 
 @pytest.fixture

@@ -117,12 +117,12 @@ def test_launch_file_sets_only_declared_parameters_of_installed_executables():
 
 
 @pytest.mark.parametrize('node', ['attitude_simulator', 'attitude_analyzer',
-                                  'poinsot_visualizer'])
+                                  'poinsot_visualizer', 'attitude_controller'])
 def test_readme_parameter_lists_are_made_from_the_tables(node):
     """The README's parameter list of each node is exactly its table's (declaration = docs)."""
-    from rigid_body_dynamics.nodes import analyzer, poinsot, simulator
+    from rigid_body_dynamics.nodes import analyzer, controller, poinsot, simulator
     table = {'attitude_simulator': simulator, 'attitude_analyzer': analyzer,
-             'poinsot_visualizer': poinsot}[node].PARAMETERS
+             'poinsot_visualizer': poinsot, 'attitude_controller': controller}[node].PARAMETERS
     readme = open(os.path.join(os.path.dirname(__file__), '..', 'README.md')).read()
     found = re.search(rf'<!-- parameters: {node} -->\n(.*?)\n<!-- /parameters: {node} -->',
                       readme, re.S)

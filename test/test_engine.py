@@ -237,6 +237,7 @@ def test_lockstep_publishes_the_tick_state_when_it_is_not_a_publish_tick():
     lock.command((0.0, 0.0, 0.0), False, clock(), stamp_ns=0)
     lock.due(outbox)
     assert [s.stamp_ns for s in outbox] == [7 * MS, 10 * MS]
+    assert [s.odom_only for s in outbox] == [False, True]     # the tick: odom (clock, TF)
 
 
 def test_disturbances_are_summed_into_the_integrated_and_reported_torque():

@@ -104,6 +104,7 @@ class Snapshot:
     omega: tuple
     torque: tuple
     inertia: object
+    odom_only: bool = False    # lockstep's tick state between publish ticks: odom (and clock, TF)
 
 
 class BodySimulation:
@@ -360,11 +361,11 @@ class BodySimulation:
         """Return the stamp (int ns) of the current simulated time."""
         return self.start_ns + int(self.steps * self.dt_ns)
 
-    def snapshot(self):
+    def snapshot(self, odom_only=False):
         """Take the current :class:`Snapshot` (call under ``lock``)."""
         s = self.stepper
         return Snapshot(self.stamp_now(), self.steps, s.q, s.omega,
-                        self.last_torque, self.inertia)
+                        self.last_torque, self.inertia, odom_only)
 
     # ------------------------------------------------------------------ diagnostics
     def health(self):

@@ -2,7 +2,8 @@
 Lockstep: the body waits for its controller at every control tick (no ROS, no wall pacing).
 
 At each control tick t_k (every ``control_every`` integration steps from 0) the
-state at t_k goes out, then the body waits until a torque command stamped at
+state at t_k goes out (a full publish tick, or, between publish ticks, an
+``odom_only`` snapshot: what a controller needs), then the body waits until a torque command stamped at
 or after t_k has arrived; that command is held from t_k on (zero-order hold)
 and the body integrates to t_{k+1} as fast as it can. Stamps and state are
 then a function of the commands only: the same controller gives the same
@@ -35,18 +36,22 @@ class Lockstep(Pace):
     Lockstep schedule of one body: ``control_every`` steps per tick, ``timeout`` (s).
 
     Counters: ``ticks`` answered, ``misses``, ``wait_ns`` (total wall time
-    spent waiting for answered ticks) and ``max_wait_ns`` since
-    :meth:`take_wait`.
+    spent waiting for answered ticks after the first) and ``max_wait_ns`` since
+    :meth:`take_wait`. ``wait_for_commands(timeout_s)``: how the waiting
+    thread waits (default: for :meth:`command` to set ``arrived``); a node
+    passes one that takes the pending commands itself and feeds them to
+    :meth:`command`.
     """
 
     def __init__(self, body, control_every, timeout, clock=time.monotonic_ns,
-                 perf=time.perf_counter):
+                 perf=time.perf_counter, wait_for_commands=None):
         super().__init__(body, 0.0, clock=clock, perf=perf)
+        self.arrived = threading.Event()
+        self.wait_for_commands = wait_for_commands or self.arrived.wait
         self.control_every = int(control_every)
         if self.control_every < 1:
             raise ValueError(f'control_every must be >= 1, got {control_every!r}')
         self.timeout_ns = int(timeout * _NS)
-        self.arrived = threading.Event()
         self.restart()
 
     def restart(self):
@@ -99,8 +104,8 @@ class Lockstep(Pace):
                 self._close_tick(answered, waited)
                 for _ in range(self.control_every):
                     body.advance(now, outbox)
-                if body.steps % body.publish_every:
-                    outbox.append(body.snapshot())      # the state at the tick always goes out
+                if body.steps % body.publish_every:     # the state at the tick always goes out
+                    outbox.append(body.snapshot(odom_only=True))
                 self._wait_start = self.clock()
                 return 0.0
             if self._first and now - self._last_repeat >= REPEAT * _NS:
@@ -109,15 +114,16 @@ class Lockstep(Pace):
                 return 0.0
             left = (self.timeout_ns - waited) / _NS if self.timeout_ns and not self._first \
                 else WAIT_SLICE
-        self.arrived.wait(min(max(left, 0.0), WAIT_SLICE))
+        self.wait_for_commands(min(max(left, 0.0), WAIT_SLICE))
         return 0.0
 
     def _close_tick(self, answered, waited):
         body = self.body
         if answered:
             self.ticks += 1
-            self.wait_ns += waited
-            self.max_wait_ns = max(self.max_wait_ns, waited)
+            if not self._first:       # the first wait is the controller's start-up
+                self.wait_ns += waited
+                self.max_wait_ns = max(self.max_wait_ns, waited)
             if self._streak:
                 body.notes.append(f'lockstep: the controller answered again after '
                                   f'{self._streak} missed ticks')
@@ -134,7 +140,7 @@ class Lockstep(Pace):
     def take_wait(self):
         """Return (mean, max) wall wait per answered tick (ms) since the last call; start over."""
         with self.body.lock:
-            mean = self.wait_ns / self.ticks / 1e6 if self.ticks else 0.0
+            mean = self.wait_ns / (self.ticks - 1) / 1e6 if self.ticks > 1 else 0.0
             result = (mean, self.max_wait_ns / 1e6)
             self.max_wait_ns = 0
         return result

@@ -6,13 +6,18 @@ message: at 1 kHz of Odometry that alone is about a quarter of a core here.
 ``Intake`` keeps its subscriptions on a hidden helper node (``_<node>_intake``,
 same namespace and context) that no executor spins, so nothing takes their
 messages but :meth:`Intake.take`, which drains everything pending in one go.
-The owner calls it from a timer (the analyzer: every 10 ms). Messages are
-taken serialised (``raw``), for :mod:`rigid_body_dynamics.cdr` to read in a
-batch. rclpy has no public take(); this is the call its executor makes
-(``handle.take_message`` inside ``with handle``), in one tested place.
+The owner calls it from a timer (the analyzer: every 10 ms), or blocks in
+:meth:`Intake.wait` until a message is pending (the simulator's lockstep
+thread: no executor hop between the controller's answer and the next step).
+Messages are taken serialised (``raw``), for :mod:`rigid_body_dynamics.cdr`
+to read in a batch or ``deserialize_message`` one by one. rclpy has no public
+take() or wait set; these are the calls its executor makes
+(``handle.take_message`` inside ``with handle``, ``_rclpy.WaitSet``), in
+one tested place.
 """
 
 import rclpy
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 
 
 class Intake:
@@ -23,11 +28,25 @@ class Intake:
                                       namespace=node.get_namespace(), context=node.context,
                                       start_parameter_services=False)
         self._subs = {}
+        self._waits = {}
 
     def subscribe(self, msg_type, topic, qos):
         """Subscribe ``topic`` (relative names resolve in the owner's namespace)."""
         self._subs[topic] = self.node.create_subscription(
             msg_type, topic, lambda _msg: None, qos, raw=True)
+
+    def wait(self, topic, timeout):
+        """Block until a message is pending on ``topic`` or ``timeout`` s pass; whether one is."""
+        sub = self._subs[topic]
+        context = self.node.context
+        with sub.handle, context.handle:
+            waits = self._waits.get(topic)
+            if waits is None:
+                waits = self._waits[topic] = _rclpy.WaitSet(1, 0, 0, 0, 0, 0, context.handle)
+            waits.clear_entities()
+            waits.add_subscription(sub.handle)
+            waits.wait(max(0, int(timeout * 1e9)))
+            return bool(waits.get_ready_entities('subscription'))
 
     def take(self, topic, limit=100_000):
         """Return the serialised messages pending on ``topic``, oldest first, at most ``limit``."""

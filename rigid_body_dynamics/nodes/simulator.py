@@ -19,6 +19,12 @@ Time. The simulated time is an integer step count times dt. Every message of
 one publish tick carries header.stamp = start + simulated time (start is the
 ROS time at start-up, or 0 with ``publish_clock``, which also publishes it on
 /clock). A ``~/reset`` returns the state *and* the simulated time to the start.
+
+Lockstep (``lockstep``): instead of the wall clock, an engine
+:class:`~rigid_body_dynamics.engine.lockstep.Lockstep` paces the body by its
+controller: the state at each control tick goes out, the body waits for a
+``torque_cmd`` stamped at or after the tick, holds it from the tick on and
+integrates to the next as fast as it can.
 """
 
 import math
@@ -33,17 +39,20 @@ import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos_overriding_options import QoSOverridingOptions
+from rclpy.serialization import deserialize_message
 from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
 from . import conversions as conv
+from .intake import Intake
 from .parameters import as_vector, ConfigurationError, Param, ParameterTable
 from .runner import run
 from .state_publisher import STATE_QOS, StatePublisher, tf_available
 from .throttle import ThrottledWarnings
-from ..engine import BodySimulation, Pace
+from ..engine import BodySimulation, Disturbances, Lockstep, Pace
 from ..engine.pacer import LATE_LIMIT
 from ..physics import Inertia, INTEGRATORS, presets
+from ..physics.disturbances import GravityGradient
 from ..physics.integrators import REMOVED as REMOVED_INTEGRATORS
 from ..physics.sensors import GyroErrors
 
@@ -135,6 +144,30 @@ def _imu_rate(values, out):
                                  f'({out["integration_rate"]:g} Hz), got {out["imu_rate"]:g}')
 
 
+def _control_steps(values, out):
+    """Cross-check: control_period is a whole number of steps (as out['control_every'])."""
+    steps = out['control_period'] * out['integration_rate']
+    every = round(steps)
+    if every < 1 or abs(steps - every) > 1e-9 * every:
+        raise ConfigurationError(
+            f'control_period must be a whole number of integration steps (dt = '
+            f'{1.0 / out["integration_rate"]:g} s), got {out["control_period"]:g} s')
+    out['control_every'] = every
+
+
+def _disturbances(values, out):
+    """Cross-check: the orbit's frame is valid when the gravity gradient is on."""
+    if out['gravity_gradient_orbit_rate'] > 0.0:
+        try:
+            GravityGradient((1.0, 1.0, 1.0), out['gravity_gradient_orbit_rate'],
+                            out['orbit_normal'], out['orbit_nadir'])
+        except ValueError as err:
+            raise ConfigurationError(str(err).replace('nadir0', 'orbit_nadir')) from None
+    out['disturbances'] = Disturbances(
+        out['disturbance_torque_body'], out['disturbance_torque_world'],
+        out['gravity_gradient_orbit_rate'], out['orbit_normal'], out['orbit_nadir'])
+
+
 def _publish_rate(values, out):
     """Cross-check: publish_rate <= integration_rate."""
     if out['publish_rate'] > out['integration_rate']:
@@ -224,10 +257,37 @@ PARAMETERS = ParameterTable([
           'Quantisation step of the gyro reading (one count; Gazebo precision); adds '
           'resolution^2 / 12 of variance that the covariance does not include. 0 = none.',
           low=0.0, high=1e3, read_only=True),
+    Param('lockstep', 'bool', False, 'false',
+          'Deterministic closed loop: at every control tick publish the state, wait for a '
+          'torque_cmd stamped at or after the tick, hold it from the tick on and integrate '
+          'to the next as fast as possible (real_time_factor and torque_timeout are unused).',
+          read_only=True),
+    Param('control_period', 'double', 0.01, '0.01 s',
+          'Lockstep control period (s): a whole number of integration steps.',
+          low=1e-6, high=1e6, read_only=True),
+    Param('lockstep_timeout', 'double', 1.0, '1.0 s',
+          'Lockstep: after the first command, a tick whose command does not come within this '
+          'wall time is a counted, logged miss and the last command is held; 0 = wait for '
+          'ever. Before the first command the wait has no limit.',
+          low=0.0, high=1e9, read_only=True),
+    Param('disturbance_torque_body', 'double[3]', [0.0, 0.0, 0.0], '[0, 0, 0] N m',
+          'Constant disturbance torque in the body frame, added to the command (and to '
+          'applied_torque).'),
+    Param('disturbance_torque_world', 'double[3]', [0.0, 0.0, 0.0], '[0, 0, 0] N m',
+          'Constant disturbance torque fixed in the world frame, added to the command.'),
+    Param('gravity_gradient_orbit_rate', 'double', 0.0, '0.0 rad/s',
+          'Orbit rate n of a circular orbit whose gravity-gradient torque 3 n^2 r x (I r) '
+          'acts on the body (r the nadir unit vector in the body frame); 0 = none. '
+          'Low Earth orbit: about 1.1e-3.', low=0.0, high=1e3, read_only=True),
+    Param('orbit_normal', 'double[3]', [0.0, 0.0, 1.0], '[0, 0, 1]',
+          'Orbit normal (world frame): nadir turns about it at n.', read_only=True),
+    Param('orbit_nadir', 'double[3]', [1.0, 0.0, 0.0], '[1, 0, 0]',
+          'Direction from the body to the planet (world frame) at simulated time 0; made '
+          'perpendicular to orbit_normal.', read_only=True),
     Param('noise_seed', 'int', 0, '0',
           'Seed of the gyro noise: the same seed and parameters give the same imu stream, bit '
           'for bit (also after ~/reset).', low=0, high=2 ** 31 - 1, read_only=True),
-], cross_checks=(_body, _publish_rate, _imu_rate))
+], cross_checks=(_body, _publish_rate, _imu_rate, _control_steps, _disturbances))
 
 
 def _preset_name(name):
@@ -260,18 +320,24 @@ class AttitudeSimulator(Node):
         self._rate = rate = values['integration_rate']
         self._warnings = ThrottledWarnings(self.get_logger())
         start_ns = 0 if self._publish_clock else self.get_clock().now().nanoseconds
+        self.lockstep = values['lockstep']
+        self._misses_seen = 0
         self.body = BodySimulation(
             values['body'], values['integrator'], rate,
             (values['initial_orientation'], values['initial_angular_velocity']),
-            values['torque_timeout'], values['max_torque'],
+            0.0 if self.lockstep else values['torque_timeout'], values['max_torque'],
             self._publish_every(values['publish_rate']), start_ns,
             imu_every=self._publish_every(values['imu_rate']) if values['publish_imu'] else 0,
             gyro=GyroErrors(values['gyro_noise_density'], values['gyro_bias_random_walk'],
                             values['gyro_turn_on_bias'], values['gyro_bias_correlation_time'],
                             values['orientation_noise'], values['gyro_resolution']),
-            seed=values['noise_seed'])
+            seed=values['noise_seed'], disturbances=values['disturbances'])
         self._publish_rate = values['publish_rate']
-        self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog)
+        if self.lockstep:
+            self.pace = Lockstep(self.body, values['control_every'], values['lockstep_timeout'],
+                                 wait_for_commands=self._take_torque)
+        else:
+            self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog)
         self._make_interfaces()
         self.state.publish_inertia(self.body.inertia, start_ns)
         with self.body.lock:
@@ -282,11 +348,15 @@ class AttitudeSimulator(Node):
         self.add_post_set_parameters_callback(self._post_set_parameters)
         body = self.body.inertia
         rtf = self.pace.rtf
+        pacing = (f'lockstep every {values["control_period"]:g} s (waiting for the first '
+                  'torque_cmd)' if self.lockstep else
+                  f'real-time factor {rtf:g}{" (as fast as possible)" if rtf == 0 else ""}')
         self.get_logger().info(
             f'{self._preset.name}: I = {body.moments.tolist()} kg m^2 ({body.kind}), '
             f'omega0 = {list(self.body.initial[1])} rad/s, {self.body.integrator_name} at '
-            f'{rate:g} Hz, publishing at {self._publish_rate:g} Hz, real-time factor '
-            f'{rtf:g}{" (as fast as possible)" if rtf == 0 else ""}')
+            f'{rate:g} Hz, publishing at {self._publish_rate:g} Hz, {pacing}')
+        if values['disturbances'].active:
+            self.get_logger().info(f'disturbances: {values["disturbances"]}')
 
     # ------------------------------------------------------------------ parameters
     def _on_set_parameters(self, params):
@@ -310,8 +380,10 @@ class AttitudeSimulator(Node):
             lines = body.configure(
                 inertia=inertia, integrator=values['integrator'],
                 initial=(values['initial_orientation'], values['initial_angular_velocity']),
-                torque_timeout=values['torque_timeout'], max_torque=values['max_torque'],
-                publish_every=self._publish_every(values['publish_rate']))
+                torque_timeout=0.0 if self.lockstep else values['torque_timeout'],
+                max_torque=values['max_torque'],
+                publish_every=self._publish_every(values['publish_rate']),
+                disturbances=values['disturbances'])
             if 'real_time_factor' in changed:
                 self.pace.set_rtf(values['real_time_factor'])
         if inertia is not None:
@@ -331,9 +403,14 @@ class AttitudeSimulator(Node):
                                    'broadcast; odom carries the same pose')
         self._pub_diag = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self._pub_rtf = self.create_publisher(Float64, '~/real_time_factor', 10)
-        self.create_subscription(
-            WrenchStamped, 'torque_cmd', self._on_torque, STATE_QOS,
-            qos_overriding_options=QoSOverridingOptions.with_default_policies())
+        if self.get_parameter('lockstep').value:
+            # the lockstep thread takes its commands itself: no executor hop in the loop
+            self._intake = Intake(self)
+            self._intake.subscribe(WrenchStamped, 'torque_cmd', STATE_QOS)
+        else:
+            self.create_subscription(
+                WrenchStamped, 'torque_cmd', self._on_torque, STATE_QOS,
+                qos_overriding_options=QoSOverridingOptions.with_default_policies())
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
 
@@ -353,15 +430,36 @@ class AttitudeSimulator(Node):
                  f'{body_frame!r}, {world_frame!r} or "" (= body)')
             return
         f = msg.wrench.force
-        events = self.body.command(conv.vector_array(msg.wrench.torque),
-                                   frame == world_frame and frame != body_frame,
-                                   time.monotonic_ns(), force=(f.x, f.y, f.z))
+        vector, world = conv.vector_array(msg.wrench.torque), \
+            frame == world_frame and frame != body_frame
+        if self.lockstep:
+            events = self.pace.command(vector, world, time.monotonic_ns(),
+                                       conv.time_ns(msg.header.stamp), force=(f.x, f.y, f.z))
+            if 'stale' in events:
+                warn('stale', 'lockstep: torque_cmd stamped before the current tick dropped '
+                     '(an answer that came after its tick was missed)')
+        else:
+            events = self.body.command(vector, world, time.monotonic_ns(),
+                                       force=(f.x, f.y, f.z))
         if 'clipped' in events:
             warn('clipped', f'torque_cmd clipped to max_torque = {self.body.max_torque:g} N m '
                  'per axis')
         if 'force_ignored' in events:
             warn('force', 'torque_cmd carries a force; only the torque is used (the body '
                  'does not translate)', period=math.inf)
+
+    def _take_torque(self, timeout):
+        """Lockstep: wait up to ``timeout`` s for torque_cmd and take every pending one."""
+        if self._intake.wait('torque_cmd', timeout):
+            for raw in self._intake.take('torque_cmd'):
+                self._on_torque(deserialize_message(raw, WrenchStamped))
+
+    def destroy_node(self):
+        """Destroy the lockstep intake's helper node too."""
+        if getattr(self, '_intake', None) is not None:
+            self._intake.destroy()
+            self._intake = None
+        super().destroy_node()
 
     # ------------------------------------------------------------------ stepping
     def start(self, diagnostics=True):
@@ -384,6 +482,8 @@ class AttitudeSimulator(Node):
     def stop(self):
         """Stop the integration thread and wait for it."""
         self._stop.set()
+        if self.lockstep:
+            self.pace.arrived.set()       # wake a lockstep wait
         if self._thread is not None:
             self._thread.join(timeout=5.0)
 
@@ -428,6 +528,12 @@ class AttitudeSimulator(Node):
         rtf = pace.rtf
         if h['paused']:
             level, message = DiagnosticStatus.OK, 'paused'
+        elif self.lockstep:
+            misses = pace.misses
+            level = DiagnosticStatus.WARN if misses > self._misses_seen else DiagnosticStatus.OK
+            self._misses_seen = misses
+            message = ('lockstep: waiting for the first torque_cmd' if not pace.ticks else
+                       f'lockstep at {achieved:.3g}x real time, {misses} missed ticks')
         elif rtf and achieved < 0.9 * rtf:
             level, message = DiagnosticStatus.WARN, (
                 f'running at {achieved:.3g}x real time, {rtf:g}x requested')
@@ -444,7 +550,7 @@ class AttitudeSimulator(Node):
             ('|L| drift since last torque (rel.)', h['momentum drift']),
             ('L direction drift since last torque (rad)', h['direction drift']),
             ('work since reset (J)', h['work']),
-        ], hw)
+        ] + self._lockstep_values(), hw)
         cmd, counts, timed_out = h['command'], h['counts'], h['timed_out']
         age = (time.monotonic_ns() - cmd.received_ns) / _NS if cmd is not None else math.inf
         rejected = counts['rejected_non_finite'] + counts['rejected_frame']
@@ -465,6 +571,16 @@ class AttitudeSimulator(Node):
         array.header.stamp = self.get_clock().now().to_msg()
         self._pub_diag.publish(array)
         self._pub_rtf.publish(Float64(data=achieved))
+
+    def _lockstep_values(self):
+        """Diagnostics of lockstep: answered and missed ticks, the wall wait per tick."""
+        if not self.lockstep:
+            return []
+        mean, worst = self.pace.take_wait()
+        return [('lockstep', True), ('control period (s)', self.pace.control_every * self.body.dt),
+                ('answered ticks', self.pace.ticks), ('missed ticks', self.pace.misses),
+                ('mean wait per answered tick (ms)', mean),
+                ('longest wait in the last period (ms)', worst)]
 
     # ------------------------------------------------------------------ services
     def _on_reset(self, _request, response):

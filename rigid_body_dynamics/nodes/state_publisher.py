@@ -97,6 +97,9 @@ class StatePublisher:
         odom.pose.pose.orientation = q_msg
         odom.twist.twist.angular = w_msg
         self._odom.publish(odom)
+        if snapshot.odom_only:       # lockstep's tick between publish ticks
+            self._publish_clock_and_tf(stamp, q_msg)
+            return
         msg = QuaternionStamped(quaternion=q_msg)
         msg.header.stamp, msg.header.frame_id = stamp, world
         self._orientation.publish(msg)
@@ -109,11 +112,15 @@ class StatePublisher:
         wrench.header.stamp, wrench.header.frame_id = stamp, body_frame
         wrench.wrench.torque = conv.vector_msg(tau_b)
         self._torque.publish(wrench)
+        self._publish_clock_and_tf(stamp, q_msg)
+
+    def _publish_clock_and_tf(self, stamp, q_msg):
         if self._clock is not None:
             self._clock.publish(ClockMsg(clock=stamp))
         if self._tf is not None:
             tf = TransformStamped()
-            tf.header.stamp, tf.header.frame_id, tf.child_frame_id = stamp, world, body_frame
+            tf.header.stamp = stamp
+            tf.header.frame_id, tf.child_frame_id = self.world_frame, self.body_frame
             tf.transform.rotation = q_msg
             self._tf.publish(TFMessage(transforms=[tf]))
 

@@ -73,7 +73,8 @@ class SimulationResult:
 
 
 def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
-             integrator='exact', torque=None, every=1, progress=None, gyro=None):
+             integrator='exact', torque=None, every=1, progress=None, gyro=None,
+             torque_every=1):
     """
     Integrate the rigid body for ``duration`` s with fixed steps ``dt`` s.
 
@@ -81,7 +82,9 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     (rad/s) and ``torque`` in the body frame of ``inertia``; ``q0`` (x, y, z,
     w) body -> world. ``torque`` is None (free), a constant 3-vector (N m) or
     a callable ``torque(t, q, omega)`` -> 3-vector evaluated at the start of
-    each step and held over it (the last row repeats the last torque).
+    each step and held over it (the last row repeats the last torque); with
+    ``torque_every`` = m it is evaluated every m-th step and held over m steps
+    (a controller's period, as attitude_simulator's lockstep holds it).
     ``integrator`` is a name from INTEGRATORS.
     ``every``: keep every n-th step. ``progress(fraction)``, if given, is
     called about a hundred times as the run goes (for long runs). ``gyro``: a
@@ -96,6 +99,8 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     if not (math.isfinite(dt) and dt > 0.0):
         raise ValueError(f'dt must be positive and finite, got {dt!r}')
     n = int(round(duration / dt))
+    if not (isinstance(torque_every, int) and torque_every >= 1):
+        raise ValueError(f'torque_every must be an integer >= 1, got {torque_every!r}')
     imu_every = _imu_every(gyro, dt)
     imu = ([], [], [], [])
     q0 = np.asarray(q0, dtype=float)
@@ -111,7 +116,7 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     t, q, w, tau, work, imp = [], [], [], [], [], []
     step = stepper.step
     for k in range(n + 1):
-        if callable(torque) and (k < n or k == 0):
+        if callable(torque) and (k < n or k == 0) and k % torque_every == 0:
             # (the last row repeats the last torque: no step starts there)
             tb = user_torque(stepper.time, *_user_state(inertia, stepper))
             tp = _principal(inertia, tb, stepper.time)

@@ -1,0 +1,197 @@
+"""
+attitude_controller: an example attitude controller for attitude_simulator.
+
+It answers states, not a wall-clock timer: each ``odom`` message whose stamp
+is at least one control period after the last answered one gets a
+``torque_cmd`` stamped with that state's stamp (what lockstep needs, and
+what a real controller should do anyway: the command says which state it
+answers). With the simulator in lockstep the closed loop is then
+deterministic; in real time it runs at ``control_rate`` of the state stream.
+
+The law lives in the physics layer (:mod:`rigid_body_dynamics.physics.control`,
+ROS-free, so ``simulate(...)`` closes the same loop offline): ``slew`` is a
+quaternion-feedback PD to ``target_orientation`` (shortest way, per-axis
+gains 2 I_i wn^2 and 2 zeta wn I_i from the latched ``inertia``, vector
+saturation at ``max_torque``); ``detumble`` damps the rate only. A
+``target_orientation`` message (geometry_msgs/QuaternionStamped) overrides
+the parameter. No command goes out before the inertia is known.
+
+States are taken by a thread of their own from a wait set (nodes/intake.py),
+not by executor callbacks: one DDS hop less of Python overhead per period.
+"""
+
+import math
+import sys
+import threading
+
+from geometry_msgs.msg import InertiaStamped, QuaternionStamped, WrenchStamped
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from rclpy.serialization import deserialize_message
+
+from . import conversions as conv
+from .intake import Intake
+from .parameters import as_vector, ConfigurationError, Param, ParameterTable
+from .runner import run
+from .state_publisher import LATCHED_QOS, STATE_QOS
+from ..physics.control import QuaternionPD, RateDamper
+
+NODE_NAME = 'attitude_controller'
+
+
+def _target(value):
+    q = as_vector('target_orientation', value, 4)
+    norm = math.sqrt(sum(c * c for c in q))
+    if not norm > 1e-9:
+        raise ConfigurationError('target_orientation must not be the zero quaternion')
+    return tuple(c / norm for c in q)
+
+
+#: The parameters of attitude_controller (README's list is made from this).
+PARAMETERS = ParameterTable([
+    Param('mode', 'string', 'slew', '`slew`',
+          'slew: quaternion PD to target_orientation; detumble: rate damping only.',
+          choices=('detumble', 'slew')),
+    Param('target_orientation', 'double[4]', [0.0, 0.0, 0.0, 1.0], '[0, 0, 0, 1]',
+          'Target attitude (x, y, z, w), body -> world; normalised. A message on '
+          'target_orientation overrides it.', convert=_target),
+    Param('natural_frequency', 'double', 1.0, '1.0 rad/s',
+          'Closed-loop natural frequency wn of each axis (small angles).', low=1e-6, high=1e4),
+    Param('damping_ratio', 'double', 0.7, '0.7', 'Closed-loop damping ratio zeta.',
+          low=1e-6, high=1e3),
+    Param('max_torque', 'double', 0.0, '0.0 N m',
+          'Vector saturation: |tau| is scaled down to this (direction kept); 0 = none.',
+          low=0.0, high=1e30),
+    Param('control_rate', 'double', 100.0, '100.0 Hz',
+          'Commands per simulated second: a state is answered when its stamp is at least '
+          '1 / control_rate after the last answered one; 0 = answer every state.',
+          low=0.0, high=1e6),
+])
+
+
+class AttitudeController(Node):
+    """The attitude_controller node; ``kwargs`` go to rclpy's Node."""
+
+    def __init__(self, **kwargs):
+        super().__init__(NODE_NAME, **kwargs)
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread = None
+        self._values = PARAMETERS.validate(PARAMETERS.declare(self))
+        self._moments = None
+        self._law = None
+        self._next_due_ns = None
+        self._last_ns = None
+        self.answered = 0
+        self._pub = self.create_publisher(WrenchStamped, 'torque_cmd', STATE_QOS)
+        self.create_subscription(InertiaStamped, 'inertia', self._on_inertia, LATCHED_QOS)
+        self.create_subscription(QuaternionStamped, 'target_orientation', self._on_target,
+                                 STATE_QOS)
+        self._intake = Intake(self)
+        self._intake.subscribe(Odometry, 'odom', STATE_QOS)
+        self.add_on_set_parameters_callback(lambda params: PARAMETERS.on_set(self, params))
+        self.add_post_set_parameters_callback(self._on_parameters)
+        v = self._values
+        self.get_logger().info(
+            f'{v["mode"]}: wn = {v["natural_frequency"]:g} rad/s, zeta = '
+            f'{v["damping_ratio"]:g}, max_torque = {v["max_torque"]:g} N m, '
+            f'{v["control_rate"]:g} Hz of state stamps; waiting for the inertia')
+
+    # ------------------------------------------------------------------ law
+    def _rebuild(self):
+        """Make the law from the values and the inertia (call under the lock)."""
+        v = self._values
+        if self._moments is None:
+            self._law = None
+        elif v['mode'] == 'detumble':
+            self._law = RateDamper(self._moments, v['natural_frequency'], v['damping_ratio'],
+                                   v['max_torque'])
+        else:
+            self._law = QuaternionPD(self._moments, v['target_orientation'],
+                                     v['natural_frequency'], v['damping_ratio'],
+                                     v['max_torque'])
+
+    def _on_inertia(self, msg):
+        i = msg.inertia
+        moments = (i.ixx, i.iyy, i.izz)      # the body axes' moments (the diagonal)
+        if not all(m > 0.0 and math.isfinite(m) for m in moments):
+            self.get_logger().warning(f'inertia ignored: diagonal {moments} is not positive')
+            return
+        with self._lock:
+            first = self._moments is None
+            self._moments = moments
+            self._rebuild()
+        if first:
+            self.get_logger().info(f'inertia diagonal {list(moments)} kg m^2: controlling')
+
+    def _on_target(self, msg):
+        try:
+            target = _target(conv.quaternion_array(msg.quaternion))
+        except ConfigurationError as err:
+            self.get_logger().warning(f'target_orientation ignored: {err}')
+            return
+        with self._lock:
+            self._values = dict(self._values, target_orientation=target)
+            self._rebuild()
+        self.get_logger().info(f'target orientation now {list(target)}')
+
+    def _on_parameters(self, params):
+        with self._lock:
+            self._values = PARAMETERS.validate(PARAMETERS.values(self))
+            self._rebuild()
+
+    # ------------------------------------------------------------------ loop
+    def start(self):
+        """Start the thread that answers states."""
+        self._thread = threading.Thread(target=self._loop, name='control', daemon=True)
+        self._thread.start()
+
+    def stop(self):
+        """Stop the thread and wait for it."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=5.0)
+
+    def _loop(self):
+        while not self._stop.is_set():
+            if not self._intake.wait('odom', 0.1):
+                continue
+            raws = self._intake.take('odom')
+            if raws:
+                self.answer(deserialize_message(raws[-1], Odometry))
+
+    def answer(self, odom):
+        """Answer one state if it is due (the newest pending one): publish torque_cmd."""
+        stamp = conv.time_ns(odom.header.stamp)
+        with self._lock:
+            law = self._law
+            rate = self._values['control_rate']
+            if self._last_ns is not None and stamp < self._last_ns:
+                self._next_due_ns = None           # the simulator was reset: start over
+            self._last_ns = stamp
+            if law is None or (self._next_due_ns is not None and stamp < self._next_due_ns):
+                return
+            self._next_due_ns = stamp + (round(1e9 / rate) if rate > 0.0 else 1)
+        o, w = odom.pose.pose.orientation, odom.twist.twist.angular
+        tau = law((o.x, o.y, o.z, o.w), (w.x, w.y, w.z))
+        cmd = WrenchStamped()
+        cmd.header.stamp = odom.header.stamp
+        cmd.header.frame_id = odom.child_frame_id
+        cmd.wrench.torque.x, cmd.wrench.torque.y, cmd.wrench.torque.z = tau
+        self._pub.publish(cmd)
+        self.answered += 1
+
+    def destroy_node(self):
+        """Destroy the intake's helper node too."""
+        self._intake.destroy()
+        super().destroy_node()
+
+
+def main(args=None, early=None):
+    """Run until Ctrl-C / SIGTERM; exit 0, or 1 on bad configuration (see runner.run)."""
+    return run(AttitudeController, NODE_NAME, args, early=early,
+               on_start=lambda node: node.start(), on_stop=lambda node: node.stop())
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,166 @@
+"""
+Closed loop over topics: lockstep determinism, the example controller, misses, disturbances.
+
+The simulator and attitude_controller run as their own processes, started
+through the package's pytest plugin (rigid_body_dynamics.testing), the way a
+user's test would start them.
+"""
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import WrenchStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+import pytest
+from rigid_body_dynamics.nodes.conversions import time_ns
+from rigid_body_dynamics.physics import presets, quaternions, simulate
+from rigid_body_dynamics.physics.control import QuaternionPD, settling_time
+from ros_harness import status_count
+
+TARGET = (0.0, 0.0, math.sin(math.pi / 8), math.cos(math.pi / 8))     # 45 degrees about z
+CONTROL = ('-p', f'target_orientation:={list(TARGET)}', '-p', 'natural_frequency:=2.0',
+           '-p', 'damping_ratio:=0.7', '-p', 'max_torque:=2.0')
+
+
+def _fields(msg):
+    """Every field of an Odometry, as a tuple (CDR bytes would include padding garbage)."""
+    p, t = msg.pose, msg.twist
+    return (time_ns(msg.header.stamp), msg.header.frame_id, msg.child_frame_id,
+            (p.pose.position.x, p.pose.position.y, p.pose.position.z),
+            (p.pose.orientation.x, p.pose.orientation.y, p.pose.orientation.z,
+             p.pose.orientation.w), tuple(p.covariance),
+            (t.twist.linear.x, t.twist.linear.y, t.twist.linear.z),
+            (t.twist.angular.x, t.twist.angular.y, t.twist.angular.z), tuple(t.covariance))
+
+
+def _stream(sim, until):
+    """Run until ``until`` s; every state's fields, in order (the t_0 repeats dropped)."""
+    sim.wait_until(until, timeout=120.0)
+    seen, out = set(), []
+    for msg in sim.odom:
+        stamp = time_ns(msg.header.stamp)
+        if stamp not in seen:
+            seen.add(stamp)
+            out.append(_fields(msg))
+    return out
+
+
+def _hogs(count=2):
+    """Busy processes, one per core: the second run happens on a loaded machine."""
+    return [subprocess.Popen([sys.executable, '-c', 'while True: pass']) for _ in range(count)]
+
+
+def test_lockstep_is_deterministic_under_load_and_equals_the_offline_loop(attitude_sim):
+    """
+    Two lockstep runs of the example controller, the second beside two CPU hogs.
+
+    Slew of the default body (spinning at 2 rad/s) to 45 degrees about z, 100 Hz control,
+    5 s simulated: both odom streams are identical, every field and stamp, and equal the offline closed loop (simulate with the same law held per 10 ms
+    period) to 1e-12.
+    """
+    runs = []
+    for loaded in (False, True):
+        hogs = _hogs() if loaded else []
+        try:
+            sim = attitude_sim('symmetric_top')
+            sim.start('attitude_controller', *CONTROL)
+            runs.append(_stream(sim, 5.0))
+            assert sim.stop() == 0
+        finally:
+            for hog in hogs:
+                hog.kill()
+                hog.wait()
+    a, b = runs
+    n = min(len(a), len(b))
+    assert n >= 501 and [f[0] for f in a[:n]] == [k * 10_000_000 for k in range(n)]
+    assert a[:n] == b[:n]                 # every field of every state, every stamp
+    # the offline loop: the same law on the same body, held per control period
+    body = presets.get('symmetric_top')
+    law = QuaternionPD(body.moments, TARGET, 2.0, 0.7, 2.0)
+    run = simulate(body.moments, body.omega0, body.q0, duration=5.0, dt=1e-3,
+                   torque=lambda t, q, w: law(q, w), torque_every=10, every=10)
+    q = np.array([f[4] for f in a[:501]])
+    w = np.array([f[7] for f in a[:501]])
+    np.testing.assert_allclose(q, run.q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(w, run.omega, rtol=0, atol=1e-12)
+    assert quaternions.angle_between(q[0], np.array(TARGET)) > 0.7      # it did slew,
+    assert quaternions.angle_between(q[-1], np.array(TARGET)) < 0.01    # spin and all
+
+
+def test_slew_in_real_time_settles_as_the_pd_theory_says(attitude_sim):
+    """
+    No lockstep: the body at rest slews 20 degrees about x at wn = 2 rad/s, zeta = 0.7.
+
+    The 2 % settling time of the error angle is within 20 % of the linear PD response's
+    (control.settling_time: 2.99 s); commands take a few ms over DDS and are held 10 ms.
+    """
+    target = (math.sin(math.radians(10.0)), 0.0, 0.0, math.cos(math.radians(10.0)))
+    sim = attitude_sim('symmetric_top', lockstep=False, initial_angular_velocity=[0, 0, 0],
+                       real_time_factor=2.0)
+    sim.start('attitude_controller', '-p', f'target_orientation:={list(target)}',
+              '-p', 'natural_frequency:=2.0', '-p', 'damping_ratio:=0.7')
+
+    def attitude():
+        t = np.array([time_ns(m.header.stamp) for m in sim.odom]) * 1e-9
+        q = np.array([[m.pose.pose.orientation.x, m.pose.pose.orientation.y,
+                       m.pose.pose.orientation.z, m.pose.pose.orientation.w] for m in sim.odom])
+        return t, np.array([quaternions.angle_between(a, np.array(target)) for a in q])
+    sim._spin_until(lambda: attitude()[1][-1] < attitude()[1][0] - 1e-6, 60.0,
+                    'the controller to move the body')
+    t, error = attitude()
+    start = t[np.flatnonzero(error < error[0] - 1e-6)[0] - 1]   # the first command acted here
+    sim.wait_until(start + 8.0, timeout=60.0)
+    t, error = attitude()
+    outside = np.flatnonzero(error > 0.02 * error[0])
+    settled = t[outside[-1]] - start
+    predicted = settling_time(2.0, 0.7)
+    assert predicted == pytest.approx(2.99, abs=0.01)
+    assert settled == pytest.approx(predicted, rel=0.20)
+    assert error[-1] < 0.005 * error[0]
+    assert sim.stop() == 0
+
+
+def test_a_controller_that_stops_answering_costs_misses_not_the_run(attitude_sim):
+    """
+    The test answers the first 20 ticks itself, then falls silent (lockstep_timeout 0.2 s).
+
+    The simulator counts the missed ticks in /diagnostics, goes on one tick per timeout with
+    the last command held, still serves ~/pause, and ends within a second of SIGINT with 0.
+    """
+    sim = attitude_sim('symmetric_top', lockstep_timeout=0.2)
+    client = sim._client
+    pub = client.node.create_publisher(WrenchStamped, 'torque_cmd', 10)
+    diags = []
+    client.node.create_subscription(DiagnosticArray, '/diagnostics', diags.append, 10)
+    answered = []
+
+    def answer(msg):
+        if len(answered) < 20 and time_ns(msg.header.stamp) not in answered:
+            answered.append(time_ns(msg.header.stamp))
+            cmd = WrenchStamped()
+            cmd.header.stamp = msg.header.stamp
+            cmd.wrench.torque.z = 0.05
+            pub.publish(cmd)
+    client.node.create_subscription(Odometry, 'odom', answer, 10)
+    client.spin_until(lambda: len(answered) == 20, 30.0, '20 answered ticks')
+    t_silent = time.monotonic()
+    sim.wait_until(0.19 + 0.05, timeout=10.0)          # 5 more ticks, each after a timeout
+    took = time.monotonic() - t_silent
+    assert 4 * 0.2 <= took < 5 * 0.2 + 1.0
+
+    class Probe:
+        messages = {'/diagnostics': diags}
+        newest_status = __import__('ros_harness').Probe.newest_status
+    client.spin_until(lambda: status_count(Probe(), 'integrator', 'missed ticks') >= 4, 5.0,
+                      'missed ticks in diagnostics')
+    assert status_count(Probe(), 'integrator', 'answered ticks') == 20
+    assert sim.pause(True) == 'paused' and sim.pause(False) == 'running'
+    start = time.monotonic()
+    sim.process.send_signal(signal.SIGINT)
+    assert sim.process.wait(5.0) == 0 and time.monotonic() - start < 1.0
