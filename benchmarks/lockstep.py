@@ -1,7 +1,9 @@
 """
-Lockstep closed loop: attitude_simulator (lockstep, 100 Hz control, 1 kHz exact steps, the
-default body slewing to 45 degrees about z) with a controller process, 20 s simulated after
-the first command. Throughput is simulated seconds per wall second; the period is the wall
+Lockstep closed loop: throughput and period, against the floor of two DDS hops.
+
+attitude_simulator (lockstep, 100 Hz control, 1 kHz exact steps, the default body
+slewing to 45 degrees about z) with a controller process, 20 s simulated after the first
+command. Throughput is simulated seconds per wall second; the period is the wall
 time between consecutive control-tick states at a recorder (p50 / p99), the wait the
 simulator's own mean wait per tick (diagnostics). The floor is a DDS ping-pong of the same
 two messages (Odometry out, WrenchStamped back) between two bare rclpy processes, once with
@@ -23,7 +25,7 @@ sys.path.insert(0, os.path.join(HERE, '..', 'test'))
 SIM_TIME = 20.0
 
 #: A ping-pong peer or a plain controller, run as its own process (argv: role).
-PEER = r'''
+PEER = r"""
 import sys, time
 import rclpy
 from rclpy.node import Node
@@ -36,7 +38,9 @@ rclpy.init()
 node = Node('peer')
 pub = node.create_publisher(WrenchStamped, 'torque_cmd', 10)
 def answer(m):
-    w = WrenchStamped(); w.header.stamp = m.header.stamp; w.wrench.torque.z = -0.1 * m.twist.twist.angular.z
+    w = WrenchStamped()
+    w.header.stamp = m.header.stamp
+    w.wrench.torque.z = -0.1 * m.twist.twist.angular.z
     pub.publish(w)
 try:
     if role == 'executor':
@@ -51,7 +55,7 @@ try:
                     answer(deserialize_message(raw, Odometry))
 except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
     pass
-'''
+"""
 
 
 def _peer(role):

@@ -15,14 +15,8 @@ and rclpy is not imported, otherwise):
   state and returns a :class:`SimulatorHandle`; every simulator and every
   process started through a handle is stopped at the end of the test.
 
-A complete test of a controller (README, "Closed loop")::
-
-    def test_detumble_settles(attitude_sim):
-        sim = attitude_sim('cubesat_3u')
-        sim.start('attitude_controller', '-p', 'mode:=detumble', '-p', 'natural_frequency:=0.5')
-        sim.wait_until(30.0)
-        t, q, omega = sim.latest()
-        assert max(abs(w) for w in omega) < 1e-3
+A complete test of a controller is in README ("Your controller in a test"),
+and the suite runs it as it stands there.
 """
 
 import os
@@ -57,7 +51,7 @@ def ros_isolation():
 
 
 def _ros_value(value):
-    """A Python value as ``-p name:=value`` text (lists and bools as ROS parses them)."""
+    """Return a Python value as ``-p name:=value`` text (lists and bools as ROS reads them)."""
     if isinstance(value, bool):
         return 'true' if value else 'false'
     if isinstance(value, (list, tuple)):
@@ -93,7 +87,7 @@ class SimulatorHandle:
         self._client.spin_until(predicate, timeout, what)
 
     def time(self):
-        """Return the simulated time (s) of the newest state received (None before any)."""
+        """Return the newest received state's simulated time in s, or None before any."""
         if not self.odom:
             return None
         stamp = self.odom[-1].header.stamp
@@ -166,7 +160,11 @@ class SimulatorHandle:
 
 @pytest.fixture
 def attitude_sim(ros_isolation):
-    """Start attitude_simulator processes: ``attitude_sim(preset, lockstep=True, **params)``."""
+    """
+    Start attitude_simulator processes: call it with a preset, lockstep and parameters.
+
+    Returns a :class:`SimulatorHandle` once the first state arrived.
+    """
     from .nodes.client import start_node
     handles = []
 

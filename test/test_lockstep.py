@@ -61,8 +61,8 @@ def test_lockstep_is_deterministic_under_load_and_equals_the_offline_loop(attitu
     Two lockstep runs of the example controller, the second beside two CPU hogs.
 
     Slew of the default body (spinning at 2 rad/s) to 45 degrees about z, 100 Hz control,
-    5 s simulated: both odom streams are identical, every field and stamp, and equal the offline closed loop (simulate with the same law held per 10 ms
-    period) to 1e-12.
+    5 s simulated: both odom streams are identical, every field and stamp, and equal the
+    offline closed loop (simulate with the same law held per 10 ms period) to 1e-12.
     """
     runs = []
     for loaded in (False, True):
@@ -164,3 +164,32 @@ def test_a_controller_that_stops_answering_costs_misses_not_the_run(attitude_sim
     start = time.monotonic()
     sim.process.send_signal(signal.SIGINT)
     assert sim.process.wait(5.0) == 0 and time.monotonic() - start < 1.0
+
+
+def test_the_readme_closed_loop_example_passes_as_written(tmp_path):
+    """The ten-line controller test of the README passes under pytest, as a user runs it."""
+    import re
+    readme = open(os.path.join(os.path.dirname(__file__), '..', 'README.md')).read()
+    block = re.search(r'<!-- closed-loop-example -->\n```python\n(.*?)```', readme, re.S)
+    assert block and len(block.group(1).strip().splitlines()) <= 12
+    (tmp_path / 'test_user.py').write_text(block.group(1))
+    env = {k: v for k, v in os.environ.items() if not k.startswith('ROS_DOMAIN')}
+    result = subprocess.run([sys.executable, '-m', 'pytest', '-q', '-p', 'no:cacheprovider',
+                             str(tmp_path / 'test_user.py')], cwd=tmp_path, env=env,
+                            capture_output=True, text=True, timeout=180)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-2000:]
+    assert '1 passed' in result.stdout
+
+
+@pytest.mark.parametrize('args, reason', [
+    (('-p', 'lockstep:=true', '-p', 'control_period:=0.0015'),
+     'control_period must be a whole number of integration steps'),
+    (('-p', 'gravity_gradient_orbit_rate:=0.001', '-p', 'orbit_normal:=[0.0, 0.0, 1.0]',
+      '-p', 'orbit_nadir:=[0.0, 0.0, -2.0]'), 'orbit_nadir must be finite and not parallel'),
+    (('-p', 'gravity_gradient_orbit_rate:=-1.0',), 'gravity_gradient_orbit_rate'),
+    (('-p', 'disturbance_torque_body:=[0.0, .nan, 0.0]',), 'disturbance_torque_body'),
+])
+def test_bad_closed_loop_parameters_are_refused_with_the_reason(launch, args, reason):
+    proc = launch('rigid_body_dynamics.nodes.simulator', *args, name='bad_closed_loop')
+    assert proc.wait(30.0) == 1
+    assert reason in proc.output()

@@ -3,9 +3,9 @@ Lockstep: the body waits for its controller at every control tick (no ROS, no wa
 
 At each control tick t_k (every ``control_every`` integration steps from 0) the
 state at t_k goes out (a full publish tick, or, between publish ticks, an
-``odom_only`` snapshot: what a controller needs), then the body waits until a torque command stamped at
-or after t_k has arrived; that command is held from t_k on (zero-order hold)
-and the body integrates to t_{k+1} as fast as it can. Stamps and state are
+``odom_only`` snapshot: what a controller needs), then the body waits until a
+torque command stamped at or after t_k has arrived; that command is held from
+t_k on (zero-order hold) and the body integrates to t_{k+1} as fast as it can. Stamps and state are
 then a function of the commands only: the same controller gives the same
 trajectory, bit for bit, however loaded the machine is.
 

@@ -145,7 +145,10 @@ def _imu_rate(values, out):
 
 
 def _control_steps(values, out):
-    """Cross-check: control_period is a whole number of steps (as out['control_every'])."""
+    """Cross-check, in lockstep: control_period is a whole number of steps (control_every)."""
+    if not out['lockstep']:
+        out['control_every'] = None
+        return
     steps = out['control_period'] * out['integration_rate']
     every = round(steps)
     if every < 1 or abs(steps - every) > 1e-9 * every:
