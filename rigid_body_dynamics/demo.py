@@ -6,17 +6,30 @@ their own processes (DDS kept on this machine, a free domain id if none is
 set), waits until the analyzer's diagnostics hold a full window of
 measurements, prints them beside theory in a few lines, and stops both nodes
 with Ctrl-C's signal: first the default symmetric top (precession rates,
-conservation), then the tennis racket (instability, growth rate, flips).
-``--offline`` measures the same straight from the physics layer, without ROS.
+conservation), then the tennis racket (instability, growth rate, flips),
+then the closed loop: ``attitude_controller`` slewing the default body at
+rest to a target in lockstep, its settling time against the PD theory and
+the pointing error at the end. ``--offline`` measures the same straight from
+the physics layer, without ROS.
 """
 
 import argparse
+import math
 import os
 import sys
 import time
 
+import numpy as np
+
 from .physics import FreeRigidBody, INTEGRATORS, presets, quaternions, simulate
 from .physics.analysis import analyse, quantity_lines, Trajectory
+from .physics.control import QuaternionPD, settling_time
+
+#: The closed-loop scene: 30 degrees about x from rest, wn 2 rad/s, zeta 0.7, 100 Hz, 10 s.
+SLEW = {'target': (math.sin(math.radians(15.0)), 0.0, 0.0, math.cos(math.radians(15.0))),
+        'natural_frequency': 2.0, 'damping_ratio': 0.7, 'control_period': 0.01,
+        'duration': 10.0}
+CLOSED_LOOP = 'closed_loop'
 
 
 def report(preset, integrator, duration, dt):
@@ -140,6 +153,80 @@ def run_nodes(preset, integrator, rate):
     return lines
 
 
+def slew_lines(t, q, how):
+    """Lines about a slew: settling time (2 %) against the PD theory, final pointing error."""
+    target = np.array(SLEW['target'])
+    error = np.array([quaternions.angle_between(a, target) for a in q])
+    outside = np.flatnonzero(error > 0.02 * error[0])
+    measured = t[outside[-1] + 1] - t[0] if outside.size and outside[-1] + 1 < t.size \
+        else math.nan
+    theory = settling_time(SLEW['natural_frequency'], SLEW['damping_ratio'])
+    body = presets.get(presets.DEFAULT)
+    return [f'{CLOSED_LOOP}: attitude_controller slews {body.name} from rest by '
+            f'{math.degrees(error[0]):.0f} deg about x (wn = {SLEW["natural_frequency"]:g} rad/s, '
+            f'zeta = {SLEW["damping_ratio"]:g}, every {SLEW["control_period"] * 1e3:g} ms), '
+            f'{how}:',
+            f'  settling time (2 %)                {measured:.3f} s      PD theory '
+            f'{theory:.3f} s  (rel. {abs(measured / theory - 1.0):.1e})',
+            f'  pointing error after {t[-1] - t[0]:g} s         {error[-1]:.1e} rad']
+
+
+def closed_loop_offline():
+    """The closed-loop scene from the physics layer: the same law held per control period."""
+    body = presets.get(presets.DEFAULT)
+    law = QuaternionPD(body.moments, SLEW['target'], SLEW['natural_frequency'],
+                       SLEW['damping_ratio'])
+    every = round(SLEW['control_period'] / 1e-3)
+    run = simulate(body.moments, (0.0, 0.0, 0.0), body.q0, SLEW['duration'], 1e-3,
+                   torque=lambda t, q, w: law(q, w), torque_every=every, every=every)
+    return slew_lines(run.t, run.q, 'offline')
+
+
+def run_closed_loop():
+    """Start the simulator in lockstep and attitude_controller; measure the slew; stop both."""
+    from nav_msgs.msg import Odometry
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    from .nodes.client import interrupt, RosClient, start_node
+    from .nodes.conversions import time_ns
+    body = presets.get(presets.DEFAULT)
+    quiet = ['--log-level', 'warn']
+    sim = start_node('simulator', quiet + [
+        '-p', f'preset:={body.name}', '-p', 'initial_angular_velocity:=[0.0, 0.0, 0.0]',
+        '-p', 'lockstep:=true', '-p', 'publish_clock:=true',
+        '-p', f'control_period:={SLEW["control_period"]}',
+        '-p', 'qos_overrides./odom.publisher.depth:=10000'])
+    states, ctl = {}, None
+    client = RosClient('rigid_body_demo')
+    try:
+        def keep(msg):
+            o = msg.pose.pose.orientation
+            states.setdefault(time_ns(msg.header.stamp), ((o.x, o.y, o.z, o.w),
+                                                           time.monotonic()))
+        client.node.create_subscription(Odometry, 'odom', keep, QoSProfile(
+            depth=10000, reliability=ReliabilityPolicy.RELIABLE))
+        client.spin_until(lambda: states, 30.0, 'the first state of attitude_simulator')
+        ctl = start_node('controller', quiet + [
+            '-p', f'target_orientation:={list(SLEW["target"])}',
+            '-p', f'natural_frequency:={SLEW["natural_frequency"]}',
+            '-p', f'damping_ratio:={SLEW["damping_ratio"]}'])
+        print(f'{CLOSED_LOOP}: started attitude_simulator in lockstep (pid {sim.pid}) and '
+              f'attitude_controller (pid {ctl.pid}) ...', flush=True)
+        client.spin_until(lambda: max(states) >= SLEW['duration'] * 1e9, 120.0,
+                          f'{SLEW["duration"]:g} simulated seconds of the slew')
+    finally:
+        client.close()
+        codes = [interrupt(proc) for proc in (ctl, sim) if proc is not None]
+    stamps = sorted(states)
+    t = np.array(stamps) * 1e-9
+    q = np.array([states[k][0] for k in stamps])
+    wall = states[stamps[-1]][1] - states[stamps[1]][1]
+    return slew_lines(t, q, 'in lockstep') + [
+        f'  {len(stamps) - 1} control ticks at {(t[-1] - t[1]) / wall:.1f}x real time; '
+        f'stopped attitude_controller and attitude_simulator (exit codes '
+        f'{", ".join(str(c) for c in codes)})']
+
+
 def _is_number(text):
     try:
         float(text)
@@ -163,17 +250,22 @@ def _ros_environment():
 def main(argv=None):
     """Console entry point: print theory against simulation (nodes, or --offline)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
-    parser.add_argument('--preset', default=None, help='preset name (default: a tour of several)')
+    parser.add_argument('--preset', default=None,
+                        help=f'preset name, or {CLOSED_LOOP} (default: a tour of all three)')
     parser.add_argument('--integrator', default='exact', choices=sorted(INTEGRATORS))
     parser.add_argument('--duration', type=float, default=None,
                         help='simulated seconds (--offline)')
     parser.add_argument('--dt', type=float, default=1e-3, help='step (s)')
     parser.add_argument('--offline', action='store_true', help='physics only, no ROS nodes')
     args = parser.parse_args(argv)
-    names = [args.preset] if args.preset else ['symmetric_top', 'tennis_racket']
+    names = [args.preset] if args.preset else ['symmetric_top', 'tennis_racket', CLOSED_LOOP]
     reservation = None if args.offline else _ros_environment()
     try:
         for name in names:
+            if name == CLOSED_LOOP:
+                lines = closed_loop_offline() if args.offline else run_closed_loop()
+                print('\n'.join(lines), flush=True)
+                continue
             body = presets.get(name)
             if args.offline:
                 lines = report(name, args.integrator, args.duration or body.duration, args.dt)

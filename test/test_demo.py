@@ -37,3 +37,15 @@ def test_demo_offline_and_bad_preset():
     assert max(_relative_errors(lines['growth rate (1/s)'])) < 1e-3
     out = _demo('--offline', '--preset', 'frisbee')
     assert out.returncode == 2 and "unknown preset 'frisbee'" in out.stderr
+
+
+def test_demo_closed_loop_scene_in_lockstep_and_offline():
+    """The third scene: settling time within 2 % of the PD theory, pointing error < 1e-5 rad."""
+    for args in (('--preset', 'closed_loop'), ('--preset', 'closed_loop', '--offline')):
+        out = _demo(*args)
+        assert out.returncode == 0, out.stderr
+        assert '--offline' in args or 'exit codes 0, 0' in out.stdout
+        settling = next(line for line in out.stdout.splitlines() if 'settling time' in line)
+        assert max(_relative_errors(settling)) < 0.02
+        pointing = next(line for line in out.stdout.splitlines() if 'pointing error' in line)
+        assert float(pointing.split()[-2]) < 1e-5
