@@ -172,7 +172,7 @@ def slew_lines(t, q, how):
 
 
 def closed_loop_offline():
-    """The closed-loop scene from the physics layer: the same law held per control period."""
+    """Run the closed-loop scene in the physics layer: the same law held per control period."""
     body = presets.get(presets.DEFAULT)
     law = QuaternionPD(body.moments, SLEW['target'], SLEW['natural_frequency'],
                        SLEW['damping_ratio'])
@@ -201,8 +201,8 @@ def run_closed_loop():
     try:
         def keep(msg):
             o = msg.pose.pose.orientation
-            states.setdefault(time_ns(msg.header.stamp), ((o.x, o.y, o.z, o.w),
-                                                           time.monotonic()))
+            states.setdefault(time_ns(msg.header.stamp),
+                              ((o.x, o.y, o.z, o.w), time.monotonic()))
         client.node.create_subscription(Odometry, 'odom', keep, QoSProfile(
             depth=10000, reliability=ReliabilityPolicy.RELIABLE))
         client.spin_until(lambda: states, 30.0, 'the first state of attitude_simulator')
