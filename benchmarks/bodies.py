@@ -59,11 +59,11 @@ def integrator_statuses(probe, since=0):
     return found
 
 
-def run_bodies(probe, way, n, window):
+def run_bodies(probe, way, n, window, extra=()):
     """Run ``n`` bodies; returns (CPU in cores, (missed total, worst body), slowest RTF, why)."""
     diags = probe.messages['/diagnostics']
     diags.clear()
-    procs = [Process(c) for c in commands(way, n)]
+    procs = [Process(c + list(extra)) for c in commands(way, n)]
     try:
         deadline = time.monotonic() + 30.0 + 2.0 * n
         while len(integrator_statuses(probe)) < n and time.monotonic() < deadline:
@@ -114,3 +114,43 @@ def measure(window=8.0, counts=COUNTS):
         probe.close()
     summary = ', '.join(f'{way}: {best.get(way, 0)}' for way in WAYS)
     return lines + ['', f'Most bodies in real time: {summary}.']
+
+
+#: The asymmetric body a new user tries (three different moments), and what they can switch off.
+ASYMMETRIC = ('-p', 'inertia:=[1.0, 2.0, 3.0]', '-p', 'initial_angular_velocity:=[0.3, 1.5, -0.4]')
+ASYMMETRIC_SETUPS = (
+    ('defaults (1 kHz steps, 7 state topics + imu at 100 Hz)', ()),
+    ('integration_rate 100 Hz', ('-p', 'integration_rate:=100.0')),
+    ('integration_rate 100 Hz, state_topics none, publish_imu false',
+     ('-p', 'integration_rate:=100.0', '-p', 'state_topics:=none', '-p', 'publish_imu:=false')),
+)
+
+
+def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128)):
+    """
+    One fleet (shared thread) of asymmetric bodies: what limits the count, what to switch off.
+
+    Every setup publishes odom of every body at 100 Hz; returns Markdown lines.
+    """
+    probe = Probe('bench_bodies_asymmetric')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    lines = ['| setup | bodies | CPU (cores) | CPU per body (% of a core) | missed deadlines '
+             '(all / worst body) | slowest achieved real-time factor | real time |',
+             '|---|---|---|---|---|---|---|']
+    try:
+        for label, extra in ASYMMETRIC_SETUPS:
+            failures = 0
+            for n in counts:
+                cpu, missed, slowest, why = run_bodies(probe, 'fleet, shared thread', n, window,
+                                                       ASYMMETRIC + extra)
+                ok = not why and missed[1] <= MAX_MISSED and slowest >= 0.99
+                lines.append(f'| {label} | {n} | {cpu:.2f} | {100 * cpu / n:.1f} | '
+                             f'{missed[0]} / {missed[1]} | {slowest:.3f} | '
+                             f'{"yes" if ok else "no"}{", " + why if why else ""} |')
+                print(lines[-1], flush=True)
+                failures = 0 if ok else failures + 1
+                if failures == 2:
+                    break
+    finally:
+        probe.close()
+    return lines

@@ -7,7 +7,7 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 ``--nodes`` measures the simulator node as a process (CPU, rates, latency);
 ``--only nodes`` skips the physics sections; ``--only torque`` runs the
 torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak | soak-rt | flood |
-bodies | hosts | analyzer-memory | bag | lockstep`` runs one reliability / scale measurement
+bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep`` runs one reliability / scale measurement
 (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
@@ -47,7 +47,7 @@ def main():
     parser.add_argument('--nodes', action='store_true', help='also the simulator node')
     parser.add_argument('--only', choices=['nodes', 'torque', 'soak', 'soak-rt', 'flood',
                                            'bodies', 'hosts', 'analyzer-memory', 'bag',
-                                           'lockstep'],
+                                           'lockstep', 'bodies-asymmetric'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -103,6 +103,7 @@ SCALE = {
     'analyzer-memory': ('analyzer_memory', 'Analyzer memory when fed faster than real time'),
     'bag': ('bag_speed', 'rigid_body_analyze on a bag of 1e6 Odometry messages'),
     'lockstep': ('lockstep', 'Lockstep closed loop: throughput and period'),
+    'bodies-asymmetric': ('bodies_asymmetric', 'Many asymmetric bodies in one fleet'),
 }
 
 

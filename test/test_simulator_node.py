@@ -509,3 +509,20 @@ def test_readme_sensor_noise_yaml_gives_that_gyro(launch, probe, tmp_path):
     white = measured - truth[index] - offline.bias[index]
     assert white.std() == pytest.approx(1e-4 * math.sqrt(200.0), rel=0.10)
     stop_cleanly(proc)
+
+
+def test_state_topics_leaves_out_what_is_not_asked_for(launch, probe):
+    """state_topics: only the named topics besides odom are published; a typo is refused."""
+    proc = launch(SIM, '-p', 'state_topics:=applied_torque', '-p', 'publish_imu:=false',
+                  name='sim_topics')
+    probe.subscribe(Odometry, 'odom')
+    probe.subscribe(WrenchStamped, 'applied_torque')
+    probe.wait_for('odom', 5)
+    probe.wait_for('applied_torque', 5)
+    for topic in ('/orientation', '/angular_velocity', '/angular_momentum',
+                  '/angular_momentum_body', '/imu'):
+        assert probe.node.get_publishers_info_by_topic(topic) == [], topic
+    stop_cleanly(proc)
+    bad = launch(SIM, '-p', 'state_topics:=odom,angular_speed', name='sim_bad_topics')
+    assert bad.wait(30.0) == 1
+    assert 'state_topics: unknown topic(s) odom, angular_speed' in bad.output()

@@ -47,7 +47,7 @@ from . import conversions as conv
 from .intake import Intake
 from .parameters import as_vector, ConfigurationError, Param, ParameterTable
 from .runner import run
-from .state_publisher import STATE_QOS, StatePublisher, tf_available
+from .state_publisher import OPTIONAL_TOPICS, STATE_QOS, StatePublisher, tf_available
 from .throttle import ThrottledWarnings
 from ..engine import BodySimulation, Disturbances, Lockstep, Pace
 from ..engine.pacer import LATE_LIMIT
@@ -124,6 +124,19 @@ def _orientation(value):
     if norm < 1e-9:
         raise ConfigurationError('initial_orientation must not be the zero quaternion')
     return tuple(c / norm for c in q)
+
+
+def _state_topics(value):
+    """Parse state_topics: 'all', 'none' or comma-separated names from OPTIONAL_TOPICS."""
+    text = str(value).strip()
+    if text == 'all':
+        return OPTIONAL_TOPICS
+    names = () if text in ('', 'none') else tuple(n.strip() for n in text.split(','))
+    unknown = [n for n in names if n not in OPTIONAL_TOPICS]
+    if unknown:
+        raise ConfigurationError(f'state_topics: unknown topic(s) {", ".join(unknown)}; use '
+                                 f'all, none or some of {", ".join(OPTIONAL_TOPICS)}')
+    return names
 
 
 def _body(values, out):
@@ -231,6 +244,11 @@ PARAMETERS = ParameterTable([
           'deadlines on a loaded machine; 0 = normal scheduling. Needs CAP_SYS_NICE or an '
           'rtprio limit (limits.conf); if refused, the node says so and runs normally.',
           low=0, high=99, read_only=True),
+    Param('state_topics', 'string', 'all', '`all`',
+          'State topics published besides odom: all, none, or a comma-separated choice of '
+          'orientation, angular_velocity, angular_momentum, angular_momentum_body, '
+          'applied_torque (odom carries attitude and rate; fewer topics let one fleet '
+          'carry more bodies, see benchmarks).', read_only=True, convert=_state_topics),
     Param('publish_tf', 'bool', True, 'true',
           'Broadcast world_frame -> body_frame on /tf (tf2_msgs/TFMessage, the odom stamp; '
           'rotation only) when tf2_msgs is importable (on a ROS install; pip-only installs '
@@ -397,9 +415,10 @@ class AttitudeSimulator(Node):
     # ------------------------------------------------------------------ interfaces
     def _make_interfaces(self):
         publish_tf = self.get_parameter('publish_tf').value
-        self.state = StatePublisher(self, self._frames,
-                                    publish_imu=self.get_parameter('publish_imu').value,
-                                    publish_clock=self._publish_clock, publish_tf=publish_tf)
+        self.state = StatePublisher(
+            self, self._frames, publish_imu=self.get_parameter('publish_imu').value,
+            publish_clock=self._publish_clock, publish_tf=publish_tf,
+            topics=_state_topics(self.get_parameter('state_topics').value))
         if publish_tf and not tf_available():
             self.get_logger().info('publish_tf: tf2_msgs is not importable here (no tf2_msgs '
                                    'wheel exists; on a ROS install it is), so /tf is not '

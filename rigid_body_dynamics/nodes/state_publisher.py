@@ -45,19 +45,31 @@ TF_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                     durability=DurabilityPolicy.VOLATILE)
 
 
+#: The state topics besides odom, each of which a node may leave out (``state_topics``).
+OPTIONAL_TOPICS = ('orientation', 'angular_velocity', 'angular_momentum',
+                   'angular_momentum_body', 'applied_torque')
+
+
 def tf_available():
     """Whether tf2_msgs can be imported here (always on a ROS install; not from pip)."""
     return TFMessage is not None
 
 
 class StatePublisher:
-    """The state publishers of one body on ``node``: ``frames`` = (world, body) frame ids."""
+    """
+    The state publishers of one body on ``node``: ``frames`` = (world, body) frame ids.
 
-    def __init__(self, node, frames, publish_imu=True, publish_clock=False, publish_tf=False):
+    ``topics``: which of OPTIONAL_TOPICS to publish besides odom (default all).
+    """
+
+    def __init__(self, node, frames, publish_imu=True, publish_clock=False, publish_tf=False,
+                 topics=OPTIONAL_TOPICS):
         self.world_frame, self.body_frame = frames
         qos_opts = QoSOverridingOptions.with_default_policies()
 
         def pub(msg_type, name, qos=STATE_QOS):
+            if name in OPTIONAL_TOPICS and name not in topics:
+                return None
             return node.create_publisher(msg_type, name, qos, qos_overriding_options=qos_opts)
         self._odom = pub(Odometry, 'odom')
         self._orientation = pub(QuaternionStamped, 'orientation')
@@ -65,6 +77,9 @@ class StatePublisher:
         self._l_world = pub(Vector3Stamped, 'angular_momentum')
         self._l_body = pub(Vector3Stamped, 'angular_momentum_body')
         self._torque = pub(WrenchStamped, 'applied_torque')
+        self._vectors = [(p, kind) for p, kind in ((self._omega, 'omega'),
+                                                   (self._l_world, 'l_world'),
+                                                   (self._l_body, 'l_body')) if p is not None]
         self._imu = pub(Imu, 'imu') if publish_imu else None
         self._imu_bias = node.create_publisher(Vector3Stamped, '~/imu_bias', STATE_QOS) \
             if publish_imu else None
@@ -85,10 +100,6 @@ class StatePublisher:
         world, body_frame = self.world_frame, self.body_frame
         q_b = inertia.attitude_to_body(np.array(q_p))
         w_b = inertia.to_body(np.array(w_p))
-        m_p = tuple(i * w for i, w in zip(inertia.moments, w_p))
-        l_world = quaternions.rotate_components(q_p, m_p)
-        l_body = inertia.to_body(np.array(m_p))
-        tau_b = inertia.to_body(np.array(snapshot.torque))
         q_msg = conv.quaternion_msg(q_b)
         w_msg = conv.vector_msg(w_b)
 
@@ -97,22 +108,32 @@ class StatePublisher:
         odom.pose.pose.orientation = q_msg
         odom.twist.twist.angular = w_msg
         self._odom.publish(odom)
-        if snapshot.odom_only:       # lockstep's tick between publish ticks
-            self._publish_clock_and_tf(stamp, q_msg)
-            return
-        msg = QuaternionStamped(quaternion=q_msg)
-        msg.header.stamp, msg.header.frame_id = stamp, world
-        self._orientation.publish(msg)
-        for pub, vec, frame in ((self._omega, w_b, body_frame), (self._l_world, l_world, world),
-                                (self._l_body, l_body, body_frame)):
-            msg = Vector3Stamped(vector=conv.vector_msg(vec))
-            msg.header.stamp, msg.header.frame_id = stamp, frame
-            pub.publish(msg)
-        wrench = WrenchStamped()
-        wrench.header.stamp, wrench.header.frame_id = stamp, body_frame
-        wrench.wrench.torque = conv.vector_msg(tau_b)
-        self._torque.publish(wrench)
+        if not snapshot.odom_only:   # (lockstep's tick between publish ticks: odom only)
+            self._publish_others(snapshot, stamp, q_msg, w_b)
         self._publish_clock_and_tf(stamp, q_msg)
+
+    def _publish_others(self, snapshot, stamp, q_msg, w_b):
+        """Publish the optional state topics of one tick (those this publisher has)."""
+        inertia, world, body_frame = snapshot.inertia, self.world_frame, self.body_frame
+        if self._orientation is not None:
+            msg = QuaternionStamped(quaternion=q_msg)
+            msg.header.stamp, msg.header.frame_id = stamp, world
+            self._orientation.publish(msg)
+        if self._vectors:
+            m_p = tuple(i * w for i, w in zip(inertia.moments, snapshot.omega))
+            vectors = {'omega': (w_b, body_frame),
+                       'l_world': (quaternions.rotate_components(snapshot.q, m_p), world),
+                       'l_body': (inertia.to_body(np.array(m_p)), body_frame)}
+            for pub, kind in self._vectors:
+                vec, frame = vectors[kind]
+                msg = Vector3Stamped(vector=conv.vector_msg(vec))
+                msg.header.stamp, msg.header.frame_id = stamp, frame
+                pub.publish(msg)
+        if self._torque is not None:
+            wrench = WrenchStamped()
+            wrench.header.stamp, wrench.header.frame_id = stamp, body_frame
+            wrench.wrench.torque = conv.vector_msg(inertia.to_body(np.array(snapshot.torque)))
+            self._torque.publish(wrench)
 
     def _publish_clock_and_tf(self, stamp, q_msg):
         if self._clock is not None:
