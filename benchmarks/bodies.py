@@ -118,17 +118,19 @@ def measure(window=8.0, counts=COUNTS):
 
 #: The asymmetric body a new user tries (three different moments), and what they can switch off.
 ASYMMETRIC = ('-p', 'inertia:=[1.0, 2.0, 3.0]', '-p', 'initial_angular_velocity:=[0.3, 1.5, -0.4]')
+FAST = ('-p', 'integration_rate:=100.0', '-p', 'state_topics:=none', '-p', 'publish_imu:=false')
 ASYMMETRIC_SETUPS = (
-    ('defaults (1 kHz steps, 7 state topics + imu at 100 Hz)', ()),
-    ('integration_rate 100 Hz', ('-p', 'integration_rate:=100.0')),
-    ('integration_rate 100 Hz, state_topics none, publish_imu false',
-     ('-p', 'integration_rate:=100.0', '-p', 'state_topics:=none', '-p', 'publish_imu:=false')),
+    ('defaults (1 kHz steps, 7 state topics + imu at 100 Hz)', 'fleet, shared thread', ()),
+    ('integration_rate 100 Hz', 'fleet, shared thread', ('-p', 'integration_rate:=100.0')),
+    ('integration_rate 100 Hz, state_topics none, publish_imu false', 'fleet, shared thread',
+     FAST),
+    ('the same in two fleets (one per core)', 'two fleets, shared thread each', FAST),
 )
 
 
-def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128)):
+def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128, 160)):
     """
-    One fleet (shared thread) of asymmetric bodies: what limits the count, what to switch off.
+    Fleets of asymmetric bodies: what limits the count, what to switch off.
 
     Every setup publishes odom of every body at 100 Hz; returns Markdown lines.
     """
@@ -138,11 +140,10 @@ def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128)):
              '(all / worst body) | slowest achieved real-time factor | real time |',
              '|---|---|---|---|---|---|---|']
     try:
-        for label, extra in ASYMMETRIC_SETUPS:
+        for label, way, extra in ASYMMETRIC_SETUPS:
             failures = 0
             for n in counts:
-                cpu, missed, slowest, why = run_bodies(probe, 'fleet, shared thread', n, window,
-                                                       ASYMMETRIC + extra)
+                cpu, missed, slowest, why = run_bodies(probe, way, n, window, ASYMMETRIC + extra)
                 ok = not why and missed[1] <= MAX_MISSED and slowest >= 0.99
                 lines.append(f'| {label} | {n} | {cpu:.2f} | {100 * cpu / n:.1f} | '
                              f'{missed[0]} / {missed[1]} | {slowest:.3f} | '
