@@ -7,7 +7,7 @@ command. Throughput is simulated seconds per wall second; the period is the wall
 time between consecutive control-tick states at a recorder (p50 / p99), the wait the
 simulator's own mean wait per tick (diagnostics). The floor is a DDS ping-pong of the same
 two messages (Odometry out, WrenchStamped back) between two bare rclpy processes, once with
-executor callbacks on both sides and once with wait-set takes (nodes/intake.py's calls).
+executor callbacks on both sides and once with wait-set takes (ros/intake.py's calls).
 Controllers: the example attitude_controller (wait-set take), and a ten-line executor-callback
 controller as a user writes first.
 """
@@ -31,7 +31,7 @@ import rclpy
 from rclpy.node import Node
 from nav_msgs.msg import Odometry
 from geometry_msgs.msg import WrenchStamped
-from rigid_body_dynamics.nodes.intake import Intake
+from rigid_body_dynamics.ros.intake import Intake
 from rclpy.serialization import deserialize_message
 role = sys.argv[1]
 rclpy.init()
@@ -69,7 +69,7 @@ def ping_pong(role, rounds=3000):
     from nav_msgs.msg import Odometry
     from rclpy.serialization import deserialize_message  # noqa: F401
     from ros_harness import interrupt, Probe
-    from rigid_body_dynamics.nodes.intake import Intake
+    from rigid_body_dynamics.ros.intake import Intake
     peer = _peer(role)
     probe = Probe('bench_ping')
     try:
@@ -99,7 +99,7 @@ def closed_loop(controller, hogs=0, extra=()):
     from diagnostic_msgs.msg import DiagnosticArray
     from nav_msgs.msg import Odometry
     from ros_harness import interrupt, NodeProcess, Probe, status_count
-    from rigid_body_dynamics.nodes.conversions import time_ns
+    from rigid_body_dynamics.ros.conversions import time_ns
     sim = NodeProcess('rigid_body_dynamics.nodes.simulator', (
         '-p', 'lockstep:=true', '-p', 'publish_clock:=true',
         '-p', 'qos_overrides./odom.publisher.depth:=10000', *extra), name='bench_lockstep_sim')

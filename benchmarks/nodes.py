@@ -19,7 +19,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from rigid_body_dynamics.nodes.conversions import status_values
+from rigid_body_dynamics.ros.conversions import status_values
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..', 'test'))

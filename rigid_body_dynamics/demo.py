@@ -59,7 +59,7 @@ def findings(statuses):
     The values are read back by key into the analysis' quantities and
     printed with the same formatter as the offline analysis.
     """
-    from .nodes import diagnostics
+    from .ros import diagnostics
     lines = []
     pre = statuses.get('precession')
     if pre:
@@ -97,8 +97,8 @@ def run_nodes(preset, integrator, rate):
     """
     from diagnostic_msgs.msg import DiagnosticArray
 
-    from .nodes.client import interrupt, RosClient, start_node, WaitTimeout
-    from .nodes.conversions import status_values
+    from .ros.client import interrupt, RosClient, start_node, WaitTimeout
+    from .ros.conversions import status_values
     body = presets.get(preset)
     kind = FreeRigidBody(body.moments, body.omega0).shape.kind
     check, key = _READY.get(kind, ('conservation', 'mode'))
@@ -187,8 +187,8 @@ def run_closed_loop():
     from nav_msgs.msg import Odometry
     from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-    from .nodes.client import interrupt, RosClient, start_node
-    from .nodes.conversions import time_ns
+    from .ros.client import interrupt, RosClient, start_node
+    from .ros.conversions import time_ns
     body = presets.get(presets.DEFAULT)
     quiet = ['--log-level', 'warn']
     sim = start_node('simulator', quiet + [

@@ -66,7 +66,7 @@ def record(path, duration, timeout=60.0):
     from rclpy.serialization import deserialize_message
     from geometry_msgs.msg import InertiaStamped, WrenchStamped
     from nav_msgs.msg import Odometry
-    from .nodes.client import RosClient, WaitTimeout
+    from .ros.client import RosClient, WaitTimeout
     from .samples import stamp_ns
     stamps, inertia, out = [], [], {}
     deep = QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE)

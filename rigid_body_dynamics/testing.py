@@ -71,7 +71,7 @@ class SimulatorHandle:
     def __init__(self, process, node_name='/attitude_simulator'):
         from rclpy.qos import QoSProfile, ReliabilityPolicy
         from nav_msgs.msg import Odometry
-        from .nodes.client import RosClient
+        from .ros.client import RosClient
         self.process = process
         self.name = node_name
         self.started = []
@@ -137,7 +137,7 @@ class SimulatorHandle:
         path for ``python -m``, or a full command list (your own controller).
         Stopped with SIGINT at the end of the test.
         """
-        from .nodes.client import start_node
+        from .ros.client import start_node
         if isinstance(executable, (list, tuple)):
             proc = subprocess.Popen(list(executable) + (['--ros-args', *ros_args]
                                                         if ros_args else []))
@@ -150,7 +150,7 @@ class SimulatorHandle:
 
     def stop(self):
         """Stop what this handle started and the simulator (SIGINT); the simulator's exit code."""
-        from .nodes.client import interrupt
+        from .ros.client import interrupt
         for proc in self.started:
             interrupt(proc)
         code = interrupt(self.process)
@@ -165,7 +165,7 @@ def attitude_sim(ros_isolation):
 
     Returns a :class:`SimulatorHandle` once the first state arrived.
     """
-    from .nodes.client import start_node
+    from .ros.client import start_node
     handles = []
 
     def start(preset='symmetric_top', lockstep=True, timeout=30.0, **parameters):

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from rcl_interfaces.srv import SetParametersAtomically
 from rclpy.parameter import Parameter
-from rigid_body_dynamics.nodes.conversions import vector_msg
+from rigid_body_dynamics.ros.conversions import vector_msg
 from rigid_body_dynamics.physics import FreeRigidBody, presets, theory
 from ros_harness import analyzer_heard, odom_msg
 from std_msgs.msg import Float64
@@ -313,7 +313,7 @@ def test_twist_frames_are_honoured(launch, probe):
     """
     from geometry_msgs.msg import InertiaStamped
     from ros_harness import LATCHED
-    from rigid_body_dynamics.nodes.conversions import vector_msg as vec
+    from rigid_body_dynamics.ros.conversions import vector_msg as vec
     from rigid_body_dynamics.physics import quaternions
     analyzer = launch(ANALYZER, name='analyzer')
     probe.subscribe(DiagnosticArray, '/diagnostics')
@@ -376,9 +376,9 @@ def test_clearing_the_inertia_parameter_falls_back_to_the_topic(launch, probe):
 
 
 def test_intake_takes_every_pending_message_in_order(probe):
-    """nodes/intake.py: messages wait on the hidden helper node until take() drains them."""
+    """ros/intake.py: messages wait on the hidden helper node until take() drains them."""
     from rclpy.serialization import deserialize_message
-    from rigid_body_dynamics.nodes.intake import Intake
+    from rigid_body_dynamics.ros.intake import Intake
     from ros_harness import DEEP
     intake = Intake(probe.node)
     try:

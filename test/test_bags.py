@@ -210,7 +210,7 @@ def test_live_analyzer_and_rigid_body_analyze_agree_on_the_same_stamps(launch, p
     rates to 1e-9.
     """
     from diagnostic_msgs.msg import DiagnosticArray
-    from rigid_body_dynamics.nodes.conversions import status_values
+    from rigid_body_dynamics.ros.conversions import status_values
     sim = launch('rigid_body_dynamics.nodes.simulator', '-p', 'publish_clock:=true',
                  '-p', 'real_time_factor:=4.0', name='sim')
     analyzer = launch('rigid_body_dynamics.nodes.analyzer', '-p', 'window:=4.0', name='analyzer')

@@ -37,9 +37,11 @@ def make_body(**kwargs):
     return BodySimulation(**options)
 
 
-def test_the_engine_imports_no_ros():
-    code = ('import sys, rigid_body_dynamics.engine; print(sorted(m for m in sys.modules '
-            'if m.split(".")[0] in ("rclpy", "rosidl_runtime_py")))')
+def test_the_physics_and_the_engine_import_no_ros():
+    code = ('import sys, rigid_body_dynamics.physics, rigid_body_dynamics.engine; '
+            'import rigid_body_dynamics.physics.disturbances, rigid_body_dynamics.physics.sensors; '
+            'print(sorted(m for m in sys.modules if m.split(".")[0] in '
+            '("rclpy", "rosidl_runtime_py", "rigid_body_dynamics.ros")))')
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0 and out.stdout.strip() == '[]', out.stdout + out.stderr
 
@@ -264,3 +266,31 @@ def test_disturbances_are_summed_into_the_integrated_and_reported_torque():
     with body.lock:
         body.configure(integrator='rk4')
         assert body._field.epoch == pytest.approx(0.1)
+
+
+def test_loop_publishes_within_its_budget_and_schedules_diagnostics():
+    """engine.Loop over two bodies: every snapshot published in order, diagnostics each period."""
+    from rigid_body_dynamics.engine import Loop, Member
+    clock = FakeClock()
+    published, diagnosed = [], []
+    members = []
+    for k in range(2):
+        body = make_body(publish_every=1)
+        pace = Pace(body, 1.0, clock=clock, perf=clock.perf)
+        members.append(Member(pace, lambda item, k=k: published.append((k, item.stamp_ns)),
+                              diagnostics=lambda k=k: diagnosed.append(k)))
+    seconds = [0.0]
+    loop = Loop(members, publish_budget=0.0, diagnostics_period=1.0,
+                clock=lambda: seconds[0], perf=lambda: seconds[0])
+    clock.advance(3 * MS)
+    wait = loop.cycle()
+    # a budget of 0 publishes only the backlog beyond 3 items per member (6 here, 0 over)
+    assert len(loop.pending) == 6 and published == [] and wait == 0.0
+    loop.budget = float('inf')
+    loop.cycle()
+    assert published == [(0, 1 * MS), (0, 2 * MS), (0, 3 * MS),
+                         (1, 1 * MS), (1, 2 * MS), (1, 3 * MS)]
+    seconds[0] = 1.5
+    loop.cycle()
+    assert diagnosed == [0, 1]
+    assert 0.0 < loop.cycle() <= 0.05                    # sleeps until the next step, capped

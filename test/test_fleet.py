@@ -11,7 +11,7 @@ from geometry_msgs.msg import InertiaStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
-from rigid_body_dynamics.nodes.conversions import status_values, time_ns
+from rigid_body_dynamics.ros.conversions import status_values, time_ns
 from rigid_body_dynamics.physics import presets
 from ros_harness import assert_exact, LATCHED, relative, stamp
 from std_srvs.srv import SetBool
@@ -29,13 +29,11 @@ PARAMS = """\
 """
 
 
-@pytest.mark.parametrize('threads', ['shared', 'per-body'])
-def test_three_bodies_in_one_process(launch, probe, tmp_path, threads):
+def test_three_bodies_in_one_process(launch, probe, tmp_path):
     """Per-body presets, exact motion, torque and pause on one body only, clean exit."""
     params = tmp_path / 'fleet.yaml'
     params.write_text(PARAMS)
-    proc = launch(FLEET, '--params-file', str(params), '--', '--bodies', '3',
-                  '--threads', threads, name=f'fleet_{threads}')
+    proc = launch(FLEET, '--params-file', str(params), '--', '--bodies', '3', name='fleet')
     probe.subscribe(DiagnosticArray, '/diagnostics')
     odom = {k: probe.subscribe(Odometry, f'/body{k}/odom') for k in (1, 2, 3)}
     inertia = {k: probe.subscribe(InertiaStamped, f'/body{k}/inertia', LATCHED)

@@ -18,7 +18,7 @@ from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
-from rigid_body_dynamics.nodes.conversions import time_ns
+from rigid_body_dynamics.ros.conversions import time_ns
 from rigid_body_dynamics.physics import presets, quaternions, simulate
 from rigid_body_dynamics.physics.control import QuaternionPD, settling_time
 from ros_harness import status_count

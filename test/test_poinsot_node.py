@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from rigid_body_dynamics.nodes.conversions import quaternion_array
+from rigid_body_dynamics.ros.conversions import quaternion_array
 from rigid_body_dynamics.physics import quaternions
 from visualization_msgs.msg import Marker, MarkerArray
 

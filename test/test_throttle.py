@@ -4,7 +4,7 @@ import logging
 import math
 import time
 
-from rigid_body_dynamics.nodes.throttle import ThrottledWarnings
+from rigid_body_dynamics.ros.throttle import ThrottledWarnings
 
 
 class Records(logging.Handler):

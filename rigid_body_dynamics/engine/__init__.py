@@ -5,13 +5,15 @@ The simulation engine without ROS: one body's state and rules, and its pacing.
 torque command, drift baseline, counters, reset and pause, snapshots at
 integer-ns stamps) and :class:`~.pacer.Pace` (real-time or as-fast-as-possible
 stepping on the steady clock), or :class:`~.lockstep.Lockstep` (waiting for
-the controller's command at every control tick). The nodes in ``nodes/`` are
-the ROS plumbing around them.
+the controller's command at every control tick), and :class:`~.loop.Loop`,
+one thread driving one pace or many. The nodes in ``nodes/`` (with the
+plumbing in ``ros/``) are the ROS side around them.
 """
 
 from .body import BodySimulation, Disturbances, ImuSample, Snapshot, TorqueCommand
 from .lockstep import Lockstep
+from .loop import Loop, Member
 from .pacer import Pace
 
-__all__ = ['BodySimulation', 'Disturbances', 'ImuSample', 'Lockstep', 'Pace', 'Snapshot',
-           'TorqueCommand']
+__all__ = ['BodySimulation', 'Disturbances', 'ImuSample', 'Lockstep', 'Loop', 'Member', 'Pace',
+           'Snapshot', 'TorqueCommand']

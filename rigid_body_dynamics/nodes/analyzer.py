@@ -33,11 +33,11 @@ from rclpy.serialization import deserialize_message
 from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
-from . import conversions as conv, diagnostics
-from .intake import Intake
-from .parameters import as_vector, ConfigurationError, Param, ParameterTable
-from .runner import run
-from .throttle import ThrottledWarnings
+from ..ros import conversions as conv, diagnostics
+from ..ros.intake import Intake
+from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
+from ..ros.runner import run
+from ..ros.throttle import ThrottledWarnings
 from .. import samples
 from ..physics import Inertia
 from ..physics.analysis import analyse, Tolerances, Trajectory

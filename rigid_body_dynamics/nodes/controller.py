@@ -16,7 +16,7 @@ saturation at ``max_torque``); ``detumble`` damps the rate only. A
 ``target_orientation`` message (geometry_msgs/QuaternionStamped) overrides
 the parameter. No command goes out before the inertia is known.
 
-States are taken by a thread of their own from a wait set (nodes/intake.py),
+States are taken by a thread of their own from a wait set (ros/intake.py),
 not by executor callbacks: one DDS hop less of Python overhead per period.
 """
 
@@ -29,11 +29,11 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.serialization import deserialize_message
 
-from . import conversions as conv
-from .intake import Intake
-from .parameters import as_vector, ConfigurationError, Param, ParameterTable
-from .runner import run
-from .state_publisher import LATCHED_QOS, STATE_QOS
+from ..ros import conversions as conv
+from ..ros.intake import Intake
+from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
+from ..ros.runner import run
+from ..ros.state_publisher import LATCHED_QOS, STATE_QOS
 from ..physics.control import QuaternionPD, RateDamper
 
 NODE_NAME = 'attitude_controller'

@@ -1,55 +1,35 @@
 """
 attitude_fleet: many bodies in one process, each a full attitude_simulator in its own namespace.
 
-Every body is an ``AttitudeSimulator`` node named ``attitude_simulator`` in
-namespace ``/<name>``, so its topics, services, parameters and diagnostics are
-exactly those of a separate ``ros2 run rigid_body_dynamics attitude_simulator
---ros-args -r __ns:=/<name>``: a controller cannot tell the difference.
-Parameters given with ``--ros-args -p`` apply to every body; a parameters
-file can set one body (key ``/<name>/attitude_simulator``) or all
-(``/**/attitude_simulator``).
+Every body is an ``AttitudeSimulator`` node in namespace ``/<name>``: its
+topics, services, parameters and diagnostics are those of ``attitude_simulator
+--ros-args -r __ns:=/<name>``. ``--ros-args -p`` sets every body; a parameters
+file one (key ``/<name>/attitude_simulator``) or all (``/**/attitude_simulator``).
+The process saves an interpreter and a DDS participant per body, and by
+default steps every body on one engine :class:`~rigid_body_dynamics.engine.Loop`
+thread that publishes within a budget between integration passes (a thread
+per body, measured in benchmarks/bodies.py, carried 4 bodies where this
+carries 48, and was removed). At most one body may publish /clock; bodies that
+share their frames do not broadcast /tf. A body at ``real_time_factor`` 0
+makes the others late: as-fast-as-possible runs belong in their own process.
 
-What the process saves: one interpreter and one DDS participant for all
-bodies, and (by default) one integration thread that steps every body in
-turn and sleeps until the earliest next deadline, instead of one thread per
-body waking at the integration rate (``--threads per-body`` keeps those, for
-comparison; benchmarks/bodies.py measures both against separate processes).
-All bodies sample their state at the same publish ticks (equal stamps); the
-shared thread publishes the ticks within a time budget between integration
-passes, so the steps stay on time while the publishing of the last bodies
-lags by a few ms.
-
-One body at most may publish /clock (``publish_clock``). A body at
-``real_time_factor`` 0 integrates in 5 ms batches on the shared thread, which
-makes the other bodies' steps late: as-fast-as-possible runs belong in their
-own process.
-
-``attitude_fleet [--bodies N] [--prefix body] [--names a,b,...] [--threads
-shared|per-body] [--ros-args ...]``
+``attitude_fleet [--bodies N] [--prefix body] [--names a,b,...] [--ros-args ...]``
 """
 
 import argparse
 import collections
-import math
 import sys
 import threading
-import time
 
 import rclpy
-from rclpy.clock import Clock, ClockType
 from rclpy.utilities import remove_ros_args
 
-from .parameters import ConfigurationError
-from .runner import run
+from ..ros.parameters import ConfigurationError
+from ..ros.runner import run
 from .simulator import AttitudeSimulator, DIAGNOSTIC_PERIOD, integration_loop, NODE_NAME
 from .simulator import SWITCH_INTERVAL
-
-
-#: Wall time the shared thread spends publishing before it integrates the steps
-#: that fell due meanwhile (s). Publishing one body's tick (7 messages) takes
-#: about 0.5 ms, integrating one step 10-30 us: publishing every body at one
-#: tick in a row would make the last bodies' next steps several ms late.
-PUBLISH_BUDGET = 0.0005
+from ..engine import Loop
+from ..engine.loop import FLEET_PUBLISH_BUDGET
 
 
 def body_names(bodies, prefix, names):
@@ -66,12 +46,11 @@ def body_names(bodies, prefix, names):
 
 
 class Fleet:
-    """The bodies of one process and the thread that steps them (``shared``) or theirs."""
+    """The bodies of one process and the thread that steps them."""
 
-    def __init__(self, names, shared=True, **kwargs):
+    def __init__(self, names, **kwargs):
         self._logger = rclpy.logging.get_logger('attitude_fleet')
         self.nodes = []
-        self.shared = shared
         self._stop = threading.Event()
         self._thread = None
         try:
@@ -90,17 +69,8 @@ class Fleet:
             raise
         self._untangle_tf()
         self.context = self.nodes[0].context     # one context, shared by every body
-        # Each executor wake-up rebuilds the wait set of every body (about 0.3 ms
-        # per body, holding the GIL), so the bodies have no diagnostics timers of
-        # their own: the shared thread publishes their diagnostics within its
-        # publishing budget, or (thread per body) one timer serves them all.
-        if not shared:
-            self.nodes[0].create_timer(DIAGNOSTIC_PERIOD, self._publish_diagnostics,
-                                       clock=Clock(clock_type=ClockType.STEADY_TIME))
-        self._logger.info(
-            f'{len(self.nodes)} bodies in this process ({", ".join(names[:5])}'
-            f'{", ..." if len(names) > 5 else ""}), '
-            f'{"one shared integration thread" if shared else "one integration thread each"}')
+        self._logger.info(f'{len(self.nodes)} bodies in this process ({", ".join(names[:5])}'
+                          f'{", ..." if len(names) > 5 else ""}), one integration thread')
 
     def _untangle_tf(self):
         """Stop /tf for bodies whose (world, body) frames another body also broadcasts."""
@@ -117,24 +87,15 @@ class Fleet:
                 'they do not broadcast /tf, which would mix them; give each its own body_frame '
                 '(key /<name>/attitude_simulator) to get TF')
 
-    def _publish_diagnostics(self):
-        for node in self.nodes:
-            node.publish_diagnostics()
-
     def start(self):
-        """Start stepping the bodies; with a thread each, every body sets the GIL interval."""
-        if not self.shared:
-            for node in self.nodes:
-                node.start(diagnostics=False)
-            return
+        """Start the thread that steps every body (diagnostics too: no timer per body)."""
         sys.setswitchinterval(SWITCH_INTERVAL)
-        self._pending = collections.deque()   # (node, snapshot or None = diagnostics)
-        self._outbox = []
-        self._next_diagnostics = time.monotonic() + DIAGNOSTIC_PERIOD
+        loop = Loop([node.member(diagnostics=True) for node in self.nodes],
+                    publish_budget=FLEET_PUBLISH_BUDGET, diagnostics_period=DIAGNOSTIC_PERIOD)
         priority = max(node.thread_priority for node in self.nodes)
         self._thread = threading.Thread(
             target=integration_loop, name='fleet integration', daemon=True,
-            args=(self._cycle, self._stop, priority, self._logger, self.context))
+            args=(loop, self._stop, priority, self._logger, self.context))
         self._thread.start()
 
     def stop(self):
@@ -142,35 +103,6 @@ class Fleet:
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
-        for node in self.nodes:
-            node.stop()
-
-    def _cycle(self):
-        """Integrate every body's due steps, publish within the budget, sleep if nothing is due."""
-        now = time.monotonic()
-        pending = self._pending
-        if now >= self._next_diagnostics:
-            self._next_diagnostics = max(self._next_diagnostics + DIAGNOSTIC_PERIOD, now)
-            pending.extend((node, None) for node in self.nodes)
-        wait = math.inf
-        outbox = self._outbox
-        for node in self.nodes:
-            wait = min(wait, node.pace.due(outbox))
-            node.log_notes()
-            if outbox:
-                pending.extend((node, snapshot) for snapshot in outbox)
-                outbox.clear()
-        # publish within a budget, then look at the deadlines again; a backlog
-        # beyond three items per body is published at once
-        end = time.perf_counter() + PUBLISH_BUDGET
-        while pending and (time.perf_counter() < end or len(pending) > 3 * len(self.nodes)):
-            node, snapshot = pending.popleft()
-            if snapshot is None:
-                node.publish_diagnostics()
-            else:
-                node.state.publish(snapshot)
-        if not pending and wait > 0.0:
-            self._stop.wait(min(wait, self._next_diagnostics - time.monotonic(), 0.05))
 
 
 def main(args=None, early=None):
@@ -184,8 +116,6 @@ def main(args=None, early=None):
     parser.add_argument('--prefix', default='body', help='namespace prefix (default body)')
     parser.add_argument('--names', default='',
                         help='comma-separated namespaces instead of --bodies/--prefix')
-    parser.add_argument('--threads', choices=['shared', 'per-body'], default='shared',
-                        help='one integration thread for all bodies (default) or one each')
     options = parser.parse_args(remove_ros_args(argv)[1:])
     if options.bodies < 1 and not options.names:
         parser.error('--bodies must be at least 1')
@@ -193,7 +123,7 @@ def main(args=None, early=None):
         names = body_names(options.bodies, options.prefix, options.names)
     except ConfigurationError as err:
         parser.error(str(err))
-    return run(lambda: Fleet(names, shared=options.threads == 'shared'), NODE_NAME, argv,
+    return run(lambda: Fleet(names), NODE_NAME, argv,
                early=early, on_start=lambda fleet: fleet.start(),
                on_stop=lambda fleet: fleet.stop())
 

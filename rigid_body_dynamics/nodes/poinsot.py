@@ -23,9 +23,9 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from . import conversions as conv
-from .parameters import ConfigurationError, Param, ParameterTable
-from .runner import run
+from ..ros import conversions as conv
+from ..ros.parameters import ConfigurationError, Param, ParameterTable
+from ..ros.runner import run
 from ..physics import Inertia, poinsot, quaternions
 
 NODE_NAME = 'poinsot_visualizer'

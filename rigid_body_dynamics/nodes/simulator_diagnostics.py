@@ -1,0 +1,93 @@
+"""
+The /diagnostics of attitude_simulator: two statuses per period, integrator and torque command.
+
+``integrator``: steps, simulated time, requested and achieved real-time
+factor, missed deadlines and lateness, quaternion norm error, drift since the
+last torque, work, and in lockstep the answered and missed ticks and the wait
+per tick. ``torque command``: age, timeout, frame, vector and the counters.
+"""
+
+import math
+import time
+
+from diagnostic_msgs.msg import DiagnosticStatus
+
+from ..engine.pacer import LATE_LIMIT
+from ..ros.conversions import status
+
+_NS = 1_000_000_000
+
+
+class SimulatorReport:
+    """Builds the statuses of one body (``body``, its ``pace``; ``lockstep``: a Lockstep)."""
+
+    def __init__(self, body, pace, lockstep):
+        self.body, self.pace, self.lockstep = body, pace, lockstep
+        self.achieved = 0.0
+        self._misses_seen = 0
+
+    def statuses(self, name, hardware_id):
+        """Return [integrator, torque command] DiagnosticStatus for node ``name``."""
+        return [self._integrator(name, hardware_id), self._torque(name, hardware_id)]
+
+    def _integrator(self, name, hw):
+        body, pace = self.body, self.pace
+        achieved = self.achieved = pace.achieved()
+        max_late = pace.take_max_late()
+        h = self._health = body.health()
+        rtf = pace.rtf
+        if h['paused']:
+            level, message = DiagnosticStatus.OK, 'paused'
+        elif self.lockstep:
+            misses = pace.misses
+            level = DiagnosticStatus.WARN if misses > self._misses_seen else DiagnosticStatus.OK
+            self._misses_seen = misses
+            message = ('lockstep: waiting for the first torque_cmd' if not pace.ticks else
+                       f'lockstep at {achieved:.3g}x real time, {misses} missed ticks')
+        elif rtf and achieved < 0.9 * rtf:
+            level, message = DiagnosticStatus.WARN, (
+                f'running at {achieved:.3g}x real time, {rtf:g}x requested')
+        else:
+            level, message = DiagnosticStatus.OK, 'running'
+        return status(f'{name}: integrator', level, message, [
+            ('integrator', body.integrator_name), ('dt (s)', body.dt), ('steps', h['steps']),
+            ('simulated time (s)', h['time']), ('requested real-time factor', rtf),
+            ('achieved real-time factor', achieved),
+            (f'missed deadlines (> {LATE_LIMIT * 1e3:g} ms late)', pace.missed),
+            ('latest step lateness in the last period (ms)', max_late),
+            ('quaternion norm error', h['quaternion norm error']),
+            ('energy drift since last torque (rel.)', h['energy drift']),
+            ('|L| drift since last torque (rel.)', h['momentum drift']),
+            ('L direction drift since last torque (rad)', h['direction drift']),
+            ('work since reset (J)', h['work']),
+        ] + self._lockstep_values(), hw)
+
+    def _lockstep_values(self):
+        """Lockstep's answered and missed ticks and the wall wait per tick ([] otherwise)."""
+        if not self.lockstep:
+            return []
+        pace = self.pace
+        mean, worst = pace.take_wait()
+        return [('lockstep', True), ('control period (s)', pace.control_every * self.body.dt),
+                ('answered ticks', pace.ticks), ('missed ticks', pace.misses),
+                ('mean wait per answered tick (ms)', mean),
+                ('longest wait in the last period (ms)', worst)]
+
+    def _torque(self, name, hw):
+        h = self._health
+        cmd, counts, timed_out = h['command'], h['counts'], h['timed_out']
+        age = (time.monotonic_ns() - cmd.received_ns) / _NS if cmd is not None else math.inf
+        rejected = counts['rejected_non_finite'] + counts['rejected_frame']
+        if cmd is None:
+            level, message = DiagnosticStatus.OK, 'no command received'
+        elif timed_out:
+            level, message = DiagnosticStatus.WARN, f'timed out {age:.2f} s after the last command'
+        else:
+            level, message = DiagnosticStatus.OK, 'holding the last command'
+        if rejected:
+            message += f'; {rejected} rejected'
+        return status(f'{name}: torque command', level, message, [
+            ('command age (s)', age), ('timed out', timed_out),
+            ('frame', 'none' if cmd is None else ('world' if cmd.world else 'body')),
+            ('command (N m)', 'none' if cmd is None else list(cmd.vector)),
+            ('timeout (s)', self.body.timeout_ns / _NS)] + list(counts.items()), hw)
