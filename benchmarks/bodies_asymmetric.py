@@ -1,4 +1,6 @@
 """
+Fleets of asymmetric bodies: how many run in real time, and what to switch off for more.
+
 attitude_fleet processes of asymmetric bodies, I = (1, 2, 3) kg m^2 (three different moments),
 odom of every body at 100 Hz: how many run in real time with the defaults, and what a user can
 switch off to carry more (integration_rate, which costs exact no accuracy; state_topics;

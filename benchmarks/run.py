@@ -6,9 +6,9 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 (``.venv/bin/pip install -r benchmarks/requirements-peers.txt``);
 ``--nodes`` measures the simulator node as a process (CPU, rates, latency);
 ``--only nodes`` skips the physics sections; ``--only torque`` runs the
-torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak | soak-rt | flood |
-bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep`` runs one reliability / scale measurement
-(see each script).
+torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak |
+soak-rt | flood | bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep``
+runs one reliability / scale measurement (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
 run now are replaced.

@@ -15,10 +15,10 @@ from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rigid_body_dynamics.physics import FreeRigidBody, quaternions
 from rigid_body_dynamics.ros.client import interrupt, RosClient, start_node  # noqa: F401
 from rigid_body_dynamics.ros.conversions import quaternion_array, quaternion_msg, status_values
 from rigid_body_dynamics.ros.conversions import time_msg, time_ns, vector_array, vector_msg
-from rigid_body_dynamics.physics import FreeRigidBody, quaternions
 
 #: Subscriber QoS for the tests: reliable with a deep queue, so nothing is dropped.
 DEEP = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10000,

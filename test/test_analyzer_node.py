@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from rcl_interfaces.srv import SetParametersAtomically
 from rclpy.parameter import Parameter
-from rigid_body_dynamics.ros.conversions import vector_msg
 from rigid_body_dynamics.physics import FreeRigidBody, presets, theory
+from rigid_body_dynamics.ros.conversions import vector_msg
 from ros_harness import analyzer_heard, odom_msg
 from std_msgs.msg import Float64
 from std_srvs.srv import Trigger

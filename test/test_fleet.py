@@ -11,8 +11,8 @@ from geometry_msgs.msg import InertiaStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
-from rigid_body_dynamics.ros.conversions import status_values, time_ns
 from rigid_body_dynamics.physics import presets
+from rigid_body_dynamics.ros.conversions import status_values, time_ns
 from ros_harness import assert_exact, LATCHED, relative, stamp
 from std_srvs.srv import SetBool
 from test_simulator_node import stop_cleanly

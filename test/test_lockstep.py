@@ -18,9 +18,9 @@ from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
-from rigid_body_dynamics.ros.conversions import time_ns
 from rigid_body_dynamics.physics import presets, quaternions, simulate
 from rigid_body_dynamics.physics.control import QuaternionPD, settling_time
+from rigid_body_dynamics.ros.conversions import time_ns
 from ros_harness import status_count
 
 TARGET = (0.0, 0.0, math.sin(math.pi / 8), math.cos(math.pi / 8))     # 45 degrees about z

@@ -2,8 +2,8 @@
 
 import numpy as np
 import pytest
-from rigid_body_dynamics.ros.conversions import quaternion_array
 from rigid_body_dynamics.physics import quaternions
+from rigid_body_dynamics.ros.conversions import quaternion_array
 from visualization_msgs.msg import Marker, MarkerArray
 
 

@@ -17,8 +17,8 @@ import pytest
 from rcl_interfaces.srv import SetParameters
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
-from rigid_body_dynamics.ros.conversions import quaternion_array, time_ns, vector_array
 from rigid_body_dynamics.physics import FreeRigidBody, Inertia, presets, quaternions, simulate
+from rigid_body_dynamics.ros.conversions import quaternion_array, time_ns, vector_array
 from ros_harness import assert_exact, LATCHED, odom_arrays, relative, stamp, status_count
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import SetBool, Trigger

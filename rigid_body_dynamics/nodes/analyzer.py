@@ -33,14 +33,14 @@ from rclpy.serialization import deserialize_message
 from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
+from .. import samples
+from ..physics import Inertia
+from ..physics.analysis import analyse, Tolerances, Trajectory
 from ..ros import conversions as conv, diagnostics
 from ..ros.intake import Intake
 from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
 from ..ros.runner import run
 from ..ros.throttle import ThrottledWarnings
-from .. import samples
-from ..physics import Inertia
-from ..physics.analysis import analyse, Tolerances, Trajectory
 
 NODE_NAME = 'attitude_analyzer'
 #: Samples needed before any rate is estimated.

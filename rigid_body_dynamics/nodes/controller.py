@@ -29,12 +29,12 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.serialization import deserialize_message
 
+from ..physics.control import QuaternionPD, RateDamper
 from ..ros import conversions as conv
 from ..ros.intake import Intake
 from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
 from ..ros.runner import run
 from ..ros.state_publisher import LATCHED_QOS, STATE_QOS
-from ..physics.control import QuaternionPD, RateDamper
 
 NODE_NAME = 'attitude_controller'
 

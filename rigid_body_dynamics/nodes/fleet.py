@@ -24,12 +24,12 @@ import threading
 import rclpy
 from rclpy.utilities import remove_ros_args
 
-from ..ros.parameters import ConfigurationError
-from ..ros.runner import run
 from .simulator import AttitudeSimulator, DIAGNOSTIC_PERIOD, integration_loop, NODE_NAME
 from .simulator import SWITCH_INTERVAL
 from ..engine import Loop
 from ..engine.loop import FLEET_PUBLISH_BUDGET
+from ..ros.parameters import ConfigurationError
+from ..ros.runner import run
 
 
 def body_names(bodies, prefix, names):

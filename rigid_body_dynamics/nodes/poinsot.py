@@ -23,10 +23,10 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
+from ..physics import Inertia, poinsot, quaternions
 from ..ros import conversions as conv
 from ..ros.parameters import ConfigurationError, Param, ParameterTable
 from ..ros.runner import run
-from ..physics import Inertia, poinsot, quaternions
 
 NODE_NAME = 'poinsot_visualizer'
 INPUT_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,

@@ -279,7 +279,7 @@ class AttitudeSimulator(Node):
         self._thread.start()
 
     def member(self, diagnostics=False):
-        """This body on an engine Loop (with ``diagnostics``: published by the loop's thread)."""
+        """Return this body as an engine Loop member (``diagnostics``: the loop publishes them)."""
         return Member(self.pace, self.state.publish, self.log_notes,
                       self.publish_diagnostics if diagnostics else None)
 
