@@ -279,7 +279,7 @@ class AttitudeSimulator(Node):
         self._thread.start()
 
     def member(self, diagnostics=False):
-        """Return this body as a member of an engine Loop (diagnostics: the loop publishes them)."""
+        """Return this body as a member of an engine Loop (diagnostics: the Loop sends them)."""
         return Member(self.pace, self.state.publish, self.log_notes,
                       self.publish_diagnostics if diagnostics else None)
 
