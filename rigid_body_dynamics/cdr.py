@@ -86,12 +86,18 @@ def odometry_arrays(raws):
     return (_stamps(buf), _field(buf, base + 24, 4), _field(buf, base + 368, 3), world, child)
 
 
-def wrench_arrays(raws):
-    """Return (t_ns, torque (N, 3) N m, frame_id) of raw geometry_msgs/WrenchStamped messages."""
+def wrench_arrays(raws, force=False):
+    """
+    Return (t_ns, torque (N, 3) N m, frame_id) of raw geometry_msgs/WrenchStamped messages.
+
+    With ``force`` also the forces (N, 3) N, as a fourth item.
+    """
     buf = _batch(raws)
     frame, end = _string(buf, 8)
     _same_bytes(buf, 8, end)
     base = _align(end, 8)
     if _HEADER + base + _WRENCH_TAIL > buf.shape[1]:
         raise NotUniform('truncated WrenchStamped')
+    if force:
+        return _stamps(buf), _field(buf, base + 24, 3), frame, _field(buf, base, 3)
     return _stamps(buf), _field(buf, base + 24, 3), frame

@@ -294,3 +294,23 @@ def test_loop_publishes_within_its_budget_and_schedules_diagnostics():
     loop.cycle()
     assert diagnosed == [0, 1]
     assert 0.0 < loop.cycle() <= 0.05                    # sleeps until the next step, capped
+
+
+def test_a_batch_of_commands_counts_and_holds_as_one_by_one():
+    """command_batch: the counters and the held command equal command() called per message."""
+    rng = np.random.default_rng(5)
+    vectors = rng.normal(scale=0.3, size=(40, 3))
+    vectors[[3, 17]] = np.nan
+    vectors[21, 1] = np.inf
+    forces = np.zeros((40, 3))
+    forces[[5, 30], 0] = 1.0
+    one, many = make_body(max_torque=0.25), make_body(max_torque=0.25)
+    for v, f in zip(vectors, forces):
+        one.command(v, False, 7, force=tuple(f))
+    events = many.command_batch(vectors, False, 7, forces)
+    assert many.counts == one.counts and many.command_held == one.command_held
+    assert events == {'accepted', 'clipped', 'force_ignored', 'rejected_non_finite'}
+    assert many.counts['rejected_non_finite'] == 3 and many.counts['force_ignored'] == 2
+    nothing = make_body()
+    assert nothing.command_batch(np.full((2, 3), np.nan), True, 0) == {'rejected_non_finite'}
+    assert nothing.command_held is None

@@ -279,10 +279,50 @@ class BodySimulation:
             self.command_held = self._make_command(vector, bool(world), int(now_ns), stamp_ns)
             return events
 
-    def reject(self, reason):
-        """Count a command refused before it got here (e.g. 'rejected_frame')."""
+    def command_batch(self, vectors, world, now_ns, forces=None):
+        """
+        Take many commands at once, as :meth:`command` one after the other would.
+
+        ``vectors`` (N, 3) N m, all body or all ``world`` frame; ``forces`` (N, 3)
+        or None. Every command is counted (non-finite ones refused, components
+        beyond ``max_torque`` clipped, forces ignored); the last finite one is
+        held. Returns the set of events that happened.
+        """
+        vectors = np.asarray(vectors, dtype=float).reshape(-1, 3)
+        finite = np.all(np.isfinite(vectors), axis=1)
+        events = set()
         with self.lock:
-            self.counts[reason] += 1
+            bad = int(np.count_nonzero(~finite))
+            if bad:
+                self.counts['rejected_non_finite'] += bad
+                events.add('rejected_non_finite')
+            good = vectors[finite]
+            if not len(good):
+                return events
+            limit = self.max_torque
+            if limit > 0.0:
+                over = int(np.count_nonzero(np.any(np.abs(good) > limit, axis=1)))
+                if over:
+                    self.counts['clipped'] += over
+                    events.add('clipped')
+            if forces is not None:
+                f = np.asarray(forces, dtype=float).reshape(-1, 3)[finite]
+                pushed = int(np.count_nonzero(np.any((f != 0.0) | ~np.isfinite(f), axis=1)))
+                if pushed:
+                    self.counts['force_ignored'] += pushed
+                    events.add('force_ignored')
+            self.counts['accepted'] += len(good)
+            events.add('accepted')
+            last = tuple(float(c) for c in good[-1])
+            if limit > 0.0:
+                last = tuple(min(max(c, -limit), limit) for c in last)
+            self.command_held = self._make_command(last, bool(world), int(now_ns))
+        return events
+
+    def reject(self, reason, count=1):
+        """Count ``count`` commands refused before they got here (e.g. 'rejected_frame')."""
+        with self.lock:
+            self.counts[reason] += count
 
     def torque_now(self, now_ns):
         """

@@ -34,12 +34,16 @@ class Pace:
     ``rtf``: simulated s per wall s (0 = as fast as possible). ``missed``
     counts steps computed more than LATE_LIMIT after their deadline,
     ``max_late_ns`` the worst lateness since :meth:`take_max_late`;
-    ``on_backlog(steps)`` is called when a backlog over MAX_LAG is dropped.
+    ``on_backlog(steps)`` is called when a backlog over MAX_LAG is dropped;
+    ``take_commands()``, if given, at the start of every :meth:`due` (a node
+    takes the pending torque commands there, so they are used from the next
+    step on, with no executor between).
     """
 
     def __init__(self, body, rtf, clock=time.monotonic_ns, perf=time.perf_counter,
-                 on_backlog=None):
+                 on_backlog=None, take_commands=None):
         self.body = body
+        self.take_commands = take_commands
         self.rtf = float(rtf)
         self.clock, self.perf = clock, perf
         self.on_backlog = on_backlog or (lambda steps: None)
@@ -72,6 +76,8 @@ class Pace:
         Returns the wall time (s) until the next step is due.
         """
         body = self.body
+        if self.take_commands is not None:
+            self.take_commands()
         with body.lock:
             if body.paused:
                 return PAUSED_WAIT

@@ -38,13 +38,13 @@ from geometry_msgs.msg import WrenchStamped
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
-from rclpy.qos_overriding_options import QoSOverridingOptions
 from rclpy.serialization import deserialize_message
 from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
 from .simulator_diagnostics import SimulatorReport
 from .simulator_parameters import PARAMETERS, state_topics
+from .. import cdr
 from ..engine import BodySimulation, Lockstep, Loop, Member, Pace
 from ..physics import presets
 from ..physics.sensors import GyroErrors
@@ -136,7 +136,8 @@ class AttitudeSimulator(Node):
             self.pace = Lockstep(self.body, values['control_every'], values['lockstep_timeout'],
                                  wait_for_commands=self._take_torque)
         else:
-            self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog)
+            self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog,
+                             take_commands=lambda: self._take_torque(None))
         self._report = SimulatorReport(self.body, self.pace, self.lockstep)
         self._make_interfaces()
         self.state.publish_inertia(self.body.inertia, start_ns)
@@ -204,14 +205,9 @@ class AttitudeSimulator(Node):
                                    'broadcast; odom carries the same pose')
         self._pub_diag = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self._pub_rtf = self.create_publisher(Float64, '~/real_time_factor', 10)
-        if self.get_parameter('lockstep').value:
-            # the lockstep thread takes its commands itself: no executor hop in the loop
-            self._intake = Intake(self)
-            self._intake.subscribe(WrenchStamped, 'torque_cmd', STATE_QOS)
-        else:
-            self.create_subscription(
-                WrenchStamped, 'torque_cmd', self._on_torque, STATE_QOS,
-                qos_overriding_options=QoSOverridingOptions.with_default_policies())
+        # the integration thread takes its commands itself: no executor hop, no callback each
+        self._intake = Intake(self)
+        self._intake.subscribe(WrenchStamped, 'torque_cmd', STATE_QOS, overridable=True)
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
 
@@ -221,14 +217,12 @@ class AttitudeSimulator(Node):
         frame = msg.header.frame_id
         if not conv.is_finite_vector(msg.wrench.torque):
             self.body.reject('rejected_non_finite')
-            warn('non-finite', 'torque_cmd rejected: non-finite torque; state unchanged')
+            self._warn_events({'rejected_non_finite'})
             return
         world_frame, body_frame = self._frames
         if frame not in ('', body_frame, world_frame):
             self.body.reject('rejected_frame')
-            shown = frame if len(frame) <= 64 else frame[:64] + '...'
-            warn('frame', f'torque_cmd rejected: unknown frame_id {shown!r}; use '
-                 f'{body_frame!r}, {world_frame!r} or "" (= body)')
+            self._warn_frame(frame)
             return
         f = msg.wrench.force
         vector, world = conv.vector_array(msg.wrench.torque), \
@@ -242,6 +236,18 @@ class AttitudeSimulator(Node):
         else:
             events = self.body.command(vector, world, time.monotonic_ns(),
                                        force=(f.x, f.y, f.z))
+        self._warn_events(events)
+
+    def _warn_frame(self, frame):
+        world_frame, body_frame = self._frames
+        shown = frame if len(frame) <= 64 else frame[:64] + '...'
+        self._warnings.warn('frame', f'torque_cmd rejected: unknown frame_id {shown!r}; use '
+                            f'{body_frame!r}, {world_frame!r} or "" (= body)')
+
+    def _warn_events(self, events):
+        warn = self._warnings.warn
+        if 'rejected_non_finite' in events:
+            warn('non-finite', 'torque_cmd rejected: non-finite torque; state unchanged')
         if 'clipped' in events:
             warn('clipped', f'torque_cmd clipped to max_torque = {self.body.max_torque:g} N m '
                  'per axis')
@@ -250,13 +256,34 @@ class AttitudeSimulator(Node):
                  'does not translate)', period=math.inf)
 
     def _take_torque(self, timeout):
-        """Lockstep: wait up to ``timeout`` s for torque_cmd and take every pending one."""
-        if self._intake.wait('torque_cmd', timeout):
-            for raw in self._intake.take('torque_cmd'):
-                self._on_torque(deserialize_message(raw, WrenchStamped))
+        """Take every pending torque_cmd (lockstep: waiting up to ``timeout`` s for one)."""
+        if timeout is not None and not self._intake.wait('torque_cmd', timeout):
+            return
+        raws = self._intake.take('torque_cmd')
+        if not raws:
+            return
+        if not self.lockstep:
+            try:        # one frame, one layout: the whole batch at once (a flood costs little)
+                self._on_torque_batch(*cdr.wrench_arrays(raws, force=True)[1:])
+                return
+            except cdr.NotUniform:
+                pass
+        for raw in raws:
+            self._on_torque(deserialize_message(raw, WrenchStamped))
+
+    def _on_torque_batch(self, torques, frame, forces):
+        """Commands of one frame taken together: counted and checked as _on_torque does."""
+        world_frame, body_frame = self._frames
+        if frame not in ('', body_frame, world_frame):
+            self.body.reject('rejected_frame', len(torques))
+            self._warn_frame(frame)
+            return
+        events = self.body.command_batch(torques, frame == world_frame and frame != body_frame,
+                                         time.monotonic_ns(), forces)
+        self._warn_events(events)
 
     def destroy_node(self):
-        """Destroy the lockstep intake's helper node too."""
+        """Destroy the torque intake's helper node too."""
         if getattr(self, '_intake', None) is not None:
             self._intake.destroy()
             self._intake = None

@@ -16,8 +16,12 @@ take() or wait set; these are the calls its executor makes
 one tested place.
 """
 
+import copy
+
 import rclpy
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+from rclpy.qos_overriding_options import _declare_qos_parameters, QoSOverridingOptions
+from rclpy.subscription import Subscription
 
 
 class Intake:
@@ -27,11 +31,22 @@ class Intake:
         self.node = rclpy.create_node(f'_{node.get_name()}_intake',
                                       namespace=node.get_namespace(), context=node.context,
                                       start_parameter_services=False)
+        self._owner = node
         self._subs = {}
         self._waits = {}
 
-    def subscribe(self, msg_type, topic, qos):
-        """Subscribe ``topic`` (relative names resolve in the owner's namespace)."""
+    def subscribe(self, msg_type, topic, qos, overridable=False):
+        """
+        Subscribe ``topic`` (relative names resolve in the owner's namespace).
+
+        ``overridable``: declare the owner's ``qos_overrides.<topic>.subscription.*``
+        parameters (history, depth, reliability), as a subscription created with
+        QoSOverridingOptions.with_default_policies() would, and use them.
+        """
+        if overridable:
+            qos = copy.copy(qos)
+            _declare_qos_parameters(Subscription, self._owner, self.node.resolve_topic_name(topic),
+                                    qos, QoSOverridingOptions.with_default_policies())
         self._subs[topic] = self.node.create_subscription(
             msg_type, topic, lambda _msg: None, qos, raw=True)
 
