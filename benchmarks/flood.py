@@ -131,6 +131,6 @@ def measure():
             print(lines[-1], flush=True)
     finally:
         probe.close()
-    return lines + ['', 'Commands are "latest wins" (a subscriber queue of 10): what the '
-                    'simulator does not take is overwritten in the queue by a newer command, '
-                    'by design; every command taken is counted as accepted or rejected.']
+    return lines + ['', 'The simulator takes every pending command at each step (a subscriber '
+                    'queue of 100, one batch decoded at once) and uses the newest; every '
+                    'command taken is counted as accepted or rejected.']

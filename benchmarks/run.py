@@ -7,7 +7,8 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 ``--nodes`` measures the simulator node as a process (CPU, rates, latency);
 ``--only nodes`` skips the physics sections; ``--only torque`` runs the
 torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak |
-soak-rt | flood | bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep``
+soak-rt | flood | bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep |
+latency``
 runs one reliability / scale measurement (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
@@ -47,7 +48,7 @@ def main():
     parser.add_argument('--nodes', action='store_true', help='also the simulator node')
     parser.add_argument('--only', choices=['nodes', 'torque', 'soak', 'soak-rt', 'flood',
                                            'bodies', 'hosts', 'analyzer-memory', 'bag',
-                                           'lockstep', 'bodies-asymmetric'],
+                                           'lockstep', 'bodies-asymmetric', 'latency'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -103,7 +104,8 @@ SCALE = {
     'analyzer-memory': ('analyzer_memory', 'Analyzer memory when fed faster than real time'),
     'bag': ('bag_speed', 'rigid_body_analyze on a bag of 1e6 Odometry messages'),
     'lockstep': ('lockstep', 'Lockstep closed loop: throughput and period'),
-    'bodies-asymmetric': ('bodies_asymmetric', 'Many asymmetric bodies in one fleet'),
+    'bodies-asymmetric': ('bodies_asymmetric', 'Many asymmetric bodies in fleets'),
+    'latency': ('latency', 'Torque command to published state, against the relay floor'),
 }
 
 

@@ -38,6 +38,7 @@ from geometry_msgs.msg import WrenchStamped
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
@@ -51,10 +52,14 @@ from ..physics.sensors import GyroErrors
 from ..ros import conversions as conv
 from ..ros.intake import Intake
 from ..ros.runner import run
-from ..ros.state_publisher import STATE_QOS, StatePublisher, tf_available
+from ..ros.state_publisher import StatePublisher, tf_available
 from ..ros.throttle import ThrottledWarnings
 
 NODE_NAME = 'attitude_simulator'
+#: torque_cmd: reliable, depth 100, so that a burst between two steps (taken at every step)
+#: is counted whole; the state uses the newest command (latest wins).
+TORQUE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+                        reliability=ReliabilityPolicy.RELIABLE)
 #: Period of /diagnostics (s, steady clock).
 DIAGNOSTIC_PERIOD = 1.0
 #: Python's GIL switch interval for the simulator process (s). The default 5 ms
@@ -207,7 +212,7 @@ class AttitudeSimulator(Node):
         self._pub_rtf = self.create_publisher(Float64, '~/real_time_factor', 10)
         # the integration thread takes its commands itself: no executor hop, no callback each
         self._intake = Intake(self)
-        self._intake.subscribe(WrenchStamped, 'torque_cmd', STATE_QOS, overridable=True)
+        self._intake.subscribe(WrenchStamped, 'torque_cmd', TORQUE_QOS, overridable=True)
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
 
