@@ -28,7 +28,7 @@ import sys
 import numpy as np
 
 from .bags import BagError, BagWriter, INERTIA, ODOMETRY, read_trajectory, WRENCH
-from .physics import estimators, INTEGRATORS, presets, quaternions, simulate
+from .physics import estimators, INTEGRATORS, momentum_sphere, presets, quaternions, simulate
 from .physics.analysis import analyse, Trajectory
 from .physics.sensors import allan_deviation, GyroErrors, GyroModel
 
@@ -158,6 +158,44 @@ def allan_figure(error, rate, errors, out_dir):
     return _save(fig, out_dir, 'allan.png'), curves
 
 
+def momentum_sphere_figure(moments, l_body, out_dir):
+    """
+    The momentum sphere |L| = |L0| with its intersection curves and the run's L_body(t).
+
+    ``moments`` principal (kg m^2), ``l_body`` (N, 3) kg m^2/s in the principal frame.
+    Loops around the major axis blue, around the minor axis green, the separatrix
+    red (physics/momentum_sphere.py). Returns (png path, curves drawn).
+    """
+    l0 = float(np.linalg.norm(l_body[0]))
+    family = momentum_sphere.curve_family(moments, l0)
+    fig, ax = _figure('Momentum sphere |L| = |L0| in the body frame: L runs along its '
+                      'intersection with 2T = L.I^-1.L', 'L_1 (kg m^2/s)', 'L_2 (kg m^2/s)',
+                      projection='3d')
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
+    ax.plot_wireframe(l0 * np.cos(u) * np.sin(v), l0 * np.sin(u) * np.sin(v), l0 * np.cos(v),
+                      color='0.85', linewidth=0.4)
+    curves = {}
+    for name, color, width in (('major', 'tab:blue', 0.8), ('minor', 'tab:green', 0.8),
+                               ('separatrix', 'tab:red', 2.0)):
+        for k, c in enumerate(family[name]):
+            label = {'major': 'loops around the major axis (stable)',
+                     'minor': 'loops around the minor axis (stable)',
+                     'separatrix': 'separatrix L^2 = 2 T I_2'}[name] if k == 0 else None
+            ax.plot(c[:, 0], c[:, 1], c[:, 2], color=color, linewidth=width, label=label)
+            curves[f'{name} {k}'] = c
+    ax.plot(l_body[:, 0], l_body[:, 1], l_body[:, 2], color='k', linewidth=1.5,
+            label='this run')
+    curves['this run'] = l_body
+    for i in range(3):
+        tip = np.zeros(3)
+        tip[i] = 1.15 * l0
+        ax.text(*tip, f'axis {i + 1}\nI{i + 1} = {moments[i]:.4g}', fontsize=8)
+    ax.set_zlabel('L_3 (kg m^2/s)')
+    ax.set_box_aspect((1, 1, 1))
+    ax.legend(loc='upper left', fontsize=7)
+    return _save(fig, out_dir, 'momentum_sphere.png'), curves
+
+
 def make_report(run, out_dir, gyro=None):
     """
     Write the figures and index.html for ``run`` into ``out_dir``.
@@ -207,6 +245,8 @@ def make_report(run, out_dir, gyro=None):
     ax.set_aspect('equal', adjustable='datalim')
     ax.legend(loc='best')
     figures['herpolhode'] = (_save(fig, out_dir, 'herpolhode.png'), {'herpolhode': plane})
+
+    figures['momentum_sphere'] = momentum_sphere_figure(moments, moments * w, out_dir)
 
     found = analyse(run)
     floor = np.finfo(float).eps

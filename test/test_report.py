@@ -13,7 +13,8 @@ from rigid_body_dynamics.physics import theory
 def test_offline_report_files_and_plotted_data(tmp_path):
     run = report.offline_run('tennis_racket', 'exact', 30.0, 0.01)
     figures, rows = report.make_report(run, str(tmp_path))
-    assert set(figures) == {'omega', 'polhode', 'herpolhode', 'conservation', 'flips'}
+    assert set(figures) == {'omega', 'polhode', 'herpolhode', 'momentum_sphere', 'conservation',
+                            'flips'}
     for path, _ in figures.values():
         assert os.path.getsize(path) > 10000                      # a real PNG
     page = open(tmp_path / 'index.html').read()
@@ -28,6 +29,17 @@ def test_offline_report_files_and_plotted_data(tmp_path):
     assert np.diff(flips).mean() == pytest.approx(expected, rel=1e-8)
     assert figures['herpolhode'][1]['herpolhode'].shape == (run.t.size, 2)
     assert {a: b for a, b, _ in rows}['flip interval (s)'].startswith('10.977572')
+    # the momentum sphere: every drawn curve on both surfaces, the run's L on its own curve
+    sphere = figures['momentum_sphere'][1]
+    moments = np.array([1.0, 2.0, 3.0])
+    l0 = np.linalg.norm(sphere['this run'][0])
+    for name, curve in sphere.items():
+        assert np.max(np.abs(np.linalg.norm(curve, axis=1) - l0)) < 1e-9 * l0, name
+        energy = np.sum(curve * curve / moments, axis=1)
+        assert np.ptp(energy) < 1e-9 * energy[0], name
+        if name.startswith('separatrix'):
+            np.testing.assert_allclose(energy * moments[1], l0 ** 2, rtol=1e-9)
+    assert sum(name.startswith('separatrix') for name in sphere) == 2
 
 
 def test_symmetric_report_has_precession_against_theory(tmp_path):

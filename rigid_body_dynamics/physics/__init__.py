@@ -7,11 +7,12 @@ Public API (stable): :class:`Inertia`, :class:`FreeRigidBody`,
 :data:`INTEGRATORS` / :func:`make_integrator`.
 """
 
-from . import analysis, control, estimators, presets, sensors, theory
+from . import analysis, control, estimators, momentum_sphere, presets, sensors, theory
 from .free_motion import FreeRigidBody
 from .inertia import Inertia
 from .integrators import INTEGRATORS, make_integrator
 from .simulation import simulate, SimulationResult
 
 __all__ = ['analysis', 'control', 'estimators', 'FreeRigidBody', 'Inertia', 'INTEGRATORS',
-           'make_integrator', 'presets', 'sensors', 'simulate', 'SimulationResult', 'theory']
+           'make_integrator', 'momentum_sphere', 'presets', 'sensors', 'simulate',
+           'SimulationResult', 'theory']
