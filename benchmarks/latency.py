@@ -8,9 +8,8 @@ a minimal rclpy relay republishes it (the floor: two DDS hops and an executor). 
 alternate, so machine noise hits both. ``./dev bench --only latency`` (about 1 minute).
 """
 
-import numpy as np
-
 from nodes import FLOOR_RELAY, latency, script, sim
+import numpy as np
 
 
 def measure(rounds=3):

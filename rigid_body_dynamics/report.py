@@ -27,6 +27,7 @@ import sys
 
 import numpy as np
 
+from . import report_page
 from .bags import BagError, BagWriter, INERTIA, ODOMETRY, read_trajectory, WRENCH
 from .physics import estimators, INTEGRATORS, momentum_sphere, presets, quaternions, simulate
 from .physics.analysis import analyse, Trajectory
@@ -160,7 +161,7 @@ def allan_figure(error, rate, errors, out_dir):
 
 def momentum_sphere_figure(moments, l_body, out_dir):
     """
-    The momentum sphere |L| = |L0| with its intersection curves and the run's L_body(t).
+    Draw the momentum sphere |L| = |L0|, its intersection curves and the run's L_body(t).
 
     ``moments`` principal (kg m^2), ``l_body`` (N, 3) kg m^2/s in the principal frame.
     Loops around the major axis blue, around the minor axis green, the separatrix
@@ -290,7 +291,8 @@ def make_report(run, out_dir, gyro=None):
     if gyro is not None:
         figures['allan'] = allan_figure(*gyro, out_dir)
     rows = findings_rows(found)
-    _write_html(run, out_dir, figures, rows)
+    interactive = report_page.write(out_dir, report_page.views(moments, t, q, w))
+    _write_html(run, out_dir, figures, rows, interactive)
     return figures, rows
 
 
@@ -327,7 +329,7 @@ def findings_rows(found):
     return rows
 
 
-def _write_html(run, out_dir, figures, rows):
+def _write_html(run, out_dir, figures, rows, interactive=''):
     table = '\n'.join(f'<tr><td>{html.escape(a)}</td><td>{html.escape(b)}</td>'
                       f'<td>{html.escape(c)}</td></tr>' for a, b, c in rows)
     images = '\n'.join(f'<figure><img src="{os.path.basename(path)}" alt="{name}">'
@@ -337,13 +339,18 @@ def _write_html(run, out_dir, figures, rows):
     span = run.span
     page = f"""<!DOCTYPE html>
 <html><head><meta charset="utf-8"><title>rigid_body_dynamics: {html.escape(run.title)}</title>
-<style>body {{ font-family: sans-serif; max-width: 900px; margin: auto; }}
+<script src="plotly.min.js"></script>
+<style>body {{ font-family: sans-serif; max-width: 1100px; margin: auto; }}
 td, th {{ padding: 2px 12px; text-align: left; }} img {{ max-width: 100%; }}</style></head>
 <body><h1>{html.escape(run.title)}</h1>
-<p>Principal moments {moments} kg m^2; {len(run)} samples over {span:.6g} s.</p>
+<p>Principal moments {moments} kg m^2; {len(run)} samples over {span:.6g} s.
+Measured against theory by the one analysis (physics/analysis.py):</p>
 <table><tr><th>quantity</th><th>measured</th><th>theory</th></tr>
 {table}
 </table>
+<p>Drag to turn a 3D view, scroll to zoom; play the body's animation or move its slider.</p>
+{interactive}
+<h2>Figures (PNG, for print and for reading without JavaScript)</h2>
 {images}
 </body></html>
 """

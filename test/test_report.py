@@ -117,3 +117,36 @@ def test_record_from_the_running_simulator(launch, tmp_path):
     assert 'transient_local' in meta.lower() or 'durability: 1' in meta
     code, _ = sim.stop()
     assert code == 0
+
+
+def test_interactive_views_draw_this_run_and_the_box_has_its_moments(tmp_path):
+    """report_page: the equivalent box reproduces the moments; frames turn it with the run."""
+    from rigid_body_dynamics import report_page
+    from rigid_body_dynamics.physics import quaternions
+    from rigid_body_dynamics.physics.inertia import equivalent_box
+    for moments in ((1.0, 2.0, 3.0), (0.0419, 0.0419, 0.00667), (2.0, 2.5, 3.5)):
+        a, b, c = equivalent_box(moments)
+        np.testing.assert_allclose([(b * b + c * c) / 12, (a * a + c * c) / 12,
+                                    (a * a + b * b) / 12], moments, rtol=1e-12)
+    run = report.offline_run('tennis_racket', 'exact', 30.0, 0.01)
+    moments = np.array([1.0, 2.0, 3.0])
+    views = report_page.views(moments, run.t, run.q, run.omega)
+    assert set(views) == {'polhode', 'herpolhode', 'momentum sphere', 'tumbling body'}
+    polhode = views['polhode'].data[1]
+    w = np.stack([polhode.x, polhode.y, polhode.z], axis=1)
+    stride = -(-run.t.size // report_page.MAX_POINTS)                 # thinned evenly
+    np.testing.assert_allclose(w, run.omega[::stride], rtol=0, atol=0)  # the run itself
+    anim = views['tumbling body']
+    assert len(anim.frames) == report_page.FRAMES
+    corners = report_page.box_vertices(moments)
+    k = np.argmin(np.abs(run.t[::stride] - float(anim.frames[60].name)))
+    box = anim.frames[60].data[0]
+    np.testing.assert_allclose(np.stack([box.x, box.y, box.z], axis=1),
+                               quaternions.rotate(np.repeat(run.q[::stride][k][None], 8, 0),
+                                                  corners),
+                               atol=1e-12)
+    flips = np.sign([f.data[-1].y[1] for f in anim.frames])       # omega_2 at each frame
+    assert np.count_nonzero(np.diff(flips)) >= 2                  # the flips are in the film
+    page = report_page.write(str(tmp_path), views)
+    assert os.path.getsize(tmp_path / 'plotly.min.js') > 1_000_000
+    assert 'src="http' not in page and 'cdn.plot.ly' not in page        # nothing online

@@ -253,3 +253,16 @@ def ellipsoid_semi_axes(moments, kinetic_energy):
     """
     m = validate_moments(moments)
     return np.array([math.sqrt(2.0 * kinetic_energy / i) for i in m])
+
+
+def equivalent_box(moments, mass=1.0):
+    """
+    Side lengths (m) of the uniform box of ``mass`` (kg) with these principal moments.
+
+    I_1 = m (b^2 + c^2) / 12 and cyclic, so a^2 = 6 (I_2 + I_3 - I_1) / m and
+    cyclic; the triangle inequality of valid moments keeps them real (a flat
+    body, I_1 + I_2 = I_3, has c = 0). Used to draw a body "shaped like" its inertia.
+    """
+    i1, i2, i3 = validate_moments(moments)
+    return np.sqrt(np.maximum(6.0 / mass * np.array([i2 + i3 - i1, i1 + i3 - i2,
+                                                     i1 + i2 - i3]), 0.0))

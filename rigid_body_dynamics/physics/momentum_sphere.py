@@ -28,14 +28,14 @@ import numpy as np
 
 
 def _axes(moments):
-    """Indices (major a, intermediate b, minor c) of the principal moments."""
+    """Return the indices (major a, intermediate b, minor c) of the principal moments."""
     order = np.argsort(np.asarray(moments, dtype=float))
     return int(order[2]), int(order[1]), int(order[0])
 
 
 def loop(moments, l0, two_t, around, points=241):
     """
-    The two loops of energy ``two_t`` (2T, J x 2) around principal axis ``around``.
+    Return the two loops of energy ``two_t`` (2T, J x 2) around principal axis ``around``.
 
     ``moments`` (principal, kg m^2), ``l0`` = |L| (kg m^2/s). Returns two (points, 3)
     arrays of L (principal frame), one at each end of the axis (closed: first = last).
@@ -62,7 +62,7 @@ def loop(moments, l0, two_t, around, points=241):
 
 def separatrix(moments, l0, points=361):
     """
-    The separatrix (L^2 = 2 T I_b): two great circles through the intermediate axis.
+    Return the two great circles of L^2 = 2 T I_b, through the intermediate axis.
 
     Returns two (points, 3) arrays of L (principal frame, closed). ValueError
     unless the three moments differ.
@@ -86,7 +86,7 @@ def separatrix(moments, l0, points=361):
 
 def curve_family(moments, l0, per_family=6, points=241):
     """
-    The intersection curves for a range of energies on the sphere |L| = ``l0``.
+    Return the intersection curves for a range of energies on the sphere |L| = ``l0``.
 
     Returns {'major': [...], 'minor': [...], 'separatrix': [...]}: loops around
     the major and the minor axis at ``per_family`` energies each, spread evenly
