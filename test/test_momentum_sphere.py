@@ -61,3 +61,18 @@ def test_axisymmetric_bodies_have_one_family_and_no_separatrix():
     assert len(family['major']) == 8 and family['minor'] == [] and family['separatrix'] == []
     with pytest.raises(ValueError, match='no loop'):
         momentum_sphere.loop(MOMENTS, 1.0, 0.1, around=0)
+
+
+def test_the_current_curve_is_the_one_l_is_on(rng):
+    """current_curve: for random L, a curve through L (within the sampling) on both surfaces."""
+    for _ in range(30):
+        L = rng.normal(size=3)
+        curve = momentum_sphere.current_curve(MOMENTS, L, points=2001)
+        l0, two_t = np.linalg.norm(L), np.sum(L * L / MOMENTS)
+        sphere, ellipsoid = _on_both(curve, l0, two_t)
+        assert sphere < 1e-12 and ellipsoid < 1e-12
+        assert np.min(np.linalg.norm(curve - L, axis=1)) < 0.01 * l0
+    on_separatrix = momentum_sphere.separatrix(MOMENTS, 1.0)[1][37]
+    curve = momentum_sphere.current_curve(MOMENTS, on_separatrix, points=361)
+    assert np.min(np.linalg.norm(curve - on_separatrix, axis=1)) < 1e-12
+    assert momentum_sphere.current_curve((2.0, 2.0, 2.0), (1.0, 0.0, 0.0)) is None

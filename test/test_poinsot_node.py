@@ -22,10 +22,12 @@ def test_markers_show_the_construction(launch, probe, preset, moments):
     arrays = probe.subscribe(MarkerArray, 'poinsot_markers')
     probe.spin_until(lambda: len(arrays) >= 30, 40.0, '30 marker arrays')
     for array in arrays[-5:]:
-        by_ns = {m.id: m for m in array.markers}
+        by_ns = {m.id: m for m in array.markers if m.ns == 'poinsot'}
         assert len(by_ns) == 6
+        sphere_ns = {m.id: m for m in array.markers if m.ns == 'momentum_sphere'}
+        assert len(sphere_ns) == 3
         for m in array.markers:
-            assert m.header.frame_id == 'odom' and m.ns == 'poinsot'
+            assert m.header.frame_id == 'odom'
             points = [_vec(p) for p in m.points]
             assert all(np.all(np.isfinite(p)) for p in points)
             assert np.all(np.isfinite([m.scale.x, m.scale.y, m.scale.z]))
@@ -50,6 +52,19 @@ def test_markers_show_the_construction(launch, probe, preset, moments):
         # the herpolhode lies in the plane too
         her = np.array([_vec(p) for p in herpolhode.points]) / scale
         np.testing.assert_allclose(her @ n_hat, np.linalg.norm(foot), rtol=1e-9)
+        # the momentum sphere: L's current curve, back in the body frame, lies on the sphere
+        # and on the energy ellipsoid of this instant's L, and L (the arrow) is on it
+        sphere, arrow, curve = (sphere_ns[i] for i in (6, 7, 8))
+        radius = 0.5 * sphere.scale.x
+        assert radius == pytest.approx(scale * np.max(semi), rel=1e-12)
+        body = quaternions.rotate_inverse(q, np.array([_vec(p) for p in curve.points]))
+        np.testing.assert_allclose(np.linalg.norm(body, axis=1), radius, rtol=1e-9)
+        l_now = quaternions.rotate_inverse(q, _vec(arrow.points[1]))
+        np.testing.assert_allclose(np.linalg.norm(l_now), radius, rtol=1e-9)
+        m = np.array(moments)
+        energy = np.sum(body * body / m, axis=1)
+        np.testing.assert_allclose(energy, np.sum(l_now * l_now / m), rtol=1e-7)
+        assert np.min(np.linalg.norm(body - l_now, axis=1)) < 0.05 * radius   # L is on it
     for proc in (viz, sim):
         code, _ = proc.stop()
         assert code == 0, proc.output()

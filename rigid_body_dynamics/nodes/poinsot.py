@@ -9,6 +9,12 @@ omega's tip, the polhode (omega's path on the ellipsoid, drawn on the current
 ellipsoid) and the herpolhode (omega's path on the plane). Lengths are omega in
 rad/s times ``scale`` (m per rad/s); traces keep the last ``trace_length``
 points. The geometry is :mod:`rigid_body_dynamics.physics.poinsot`.
+
+Namespace ``momentum_sphere`` (to toggle apart in RViz): the momentum sphere
+|L| = |L0| turning with the body, drawn with the radius of the ellipsoid's
+largest semi-axis, the L arrow on it, and the intersection curve with the
+energy ellipsoid that L currently runs along
+(:func:`rigid_body_dynamics.physics.momentum_sphere.current_curve`).
 """
 
 from collections import deque
@@ -23,7 +29,7 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from ..physics import Inertia, poinsot, quaternions
+from ..physics import Inertia, momentum_sphere, poinsot, quaternions
 from ..ros import conversions as conv
 from ..ros.parameters import ConfigurationError, Param, ParameterTable
 from ..ros.runner import run
@@ -36,8 +42,12 @@ LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
 COLORS = {'ellipsoid': (0.2, 0.5, 0.9, 0.35), 'omega': (0.9, 0.2, 0.2, 1.0),
           'normal': (0.2, 0.8, 0.2, 1.0), 'plane': (0.8, 0.8, 0.2, 0.25),
-          'polhode': (1.0, 0.5, 0.0, 1.0), 'herpolhode': (0.6, 0.2, 0.8, 1.0)}
+          'polhode': (1.0, 0.5, 0.0, 1.0), 'herpolhode': (0.6, 0.2, 0.8, 1.0),
+          'sphere': (0.7, 0.7, 0.7, 0.2), 'momentum': (0.1, 0.1, 0.1, 1.0),
+          'curve': (0.9, 0.1, 0.1, 1.0)}
 IDS = {name: i for i, name in enumerate(COLORS)}
+#: Markers in the momentum-sphere namespace (the others are in ``poinsot``).
+SPHERE_MARKERS = ('sphere', 'momentum', 'curve')
 
 
 def _point(v):
@@ -124,7 +134,8 @@ class PoinsotVisualizer(Node):
             self._pub.publish(self._markers(msg.header, geometry))
 
     def _marker(self, header, name, kind):
-        m = Marker(header=header, ns='poinsot', id=IDS[name], type=kind, action=Marker.ADD)
+        ns = 'momentum_sphere' if name in SPHERE_MARKERS else 'poinsot'
+        m = Marker(header=header, ns=ns, id=IDS[name], type=kind, action=Marker.ADD)
         m.color = ColorRGBA(r=COLORS[name][0], g=COLORS[name][1], b=COLORS[name][2],
                             a=COLORS[name][3])
         m.pose.orientation.w = 1.0
@@ -159,7 +170,29 @@ class PoinsotVisualizer(Node):
         for trace in (polhode, herpolhode):
             trace.scale.x = width
             out.append(trace)
+        out += self._sphere_markers(header, g, k * float(np.max(g.semi_axes)), width)
         return MarkerArray(markers=out)
+
+    def _sphere_markers(self, header, g, radius, width):
+        """Draw the momentum sphere (radius m), L on it and L's current curve, world frame."""
+        moments = self._inertia.moments
+        l_body = moments * quaternions.rotate_inverse(g.orientation, g.omega)
+        l0 = float(np.linalg.norm(l_body))
+        sphere = self._marker(header, 'sphere', Marker.SPHERE)
+        sphere.pose.orientation = conv.quaternion_msg(g.orientation)
+        sphere.scale.x = sphere.scale.y = sphere.scale.z = 2.0 * radius
+        arrow = self._marker(header, 'momentum', Marker.ARROW)
+        arrow.points = [_point((0.0, 0.0, 0.0)), _point(radius * g.normal)]
+        arrow.scale.x, arrow.scale.y, arrow.scale.z = width, 2.0 * width, 4.0 * width
+        out = [sphere, arrow]
+        curve = momentum_sphere.current_curve(moments, l_body)
+        if curve is not None:
+            line = self._marker(header, 'curve', Marker.LINE_STRIP)
+            world = quaternions.rotate(g.orientation, curve) * (radius / l0)
+            line.points = [_point(p) for p in world]
+            line.scale.x = width
+            out.append(line)
+        return out
 
 
 def main(args=None, early=None):

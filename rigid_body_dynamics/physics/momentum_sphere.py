@@ -108,3 +108,28 @@ def curve_family(moments, l0, per_family=6, points=241):
     if m[a] > m[b] > m[c]:
         out['separatrix'] = separatrix(m, l0, points)
     return out
+
+
+def current_curve(moments, l_body, points=241):
+    """
+    Return the intersection curve the angular momentum ``l_body`` (principal frame) is on.
+
+    The loop (around the major or the minor axis, the one at the end of the
+    axis where L is) of its |L| and 2T, or the separatrix circle nearer to it
+    when 2T is within 1e-12 of L^2 / I_b; (points, 3) kg m^2/s. None for a
+    sphere (every L is at rest on it) or L = 0.
+    """
+    m = np.asarray(moments, dtype=float)
+    L = np.asarray(l_body, dtype=float)
+    l0 = float(np.linalg.norm(L))
+    a, b, c = _axes(m)
+    if l0 == 0.0 or m[a] == m[c]:
+        return None
+    two_t = float(np.sum(L * L / m))
+    middle = l0 * l0 / m[b]
+    if m[a] > m[b] > m[c] and abs(two_t - middle) <= 1e-12 * middle:
+        circles = separatrix(m, l0, points)
+        return min(circles, key=lambda circle: np.min(np.linalg.norm(circle - L, axis=1)))
+    around = a if (m[a] > m[b] and two_t <= middle) else c
+    loops = loop(m, l0, two_t, around, points)
+    return loops[0] if L[around] >= 0.0 else loops[1]
