@@ -1,17 +1,13 @@
 """
 attitude_fleet: many bodies in one process, each a full attitude_simulator in its own namespace.
 
-Every body is an ``AttitudeSimulator`` node in namespace ``/<name>``: its
-topics, services, parameters and diagnostics are those of ``attitude_simulator
---ros-args -r __ns:=/<name>``. ``--ros-args -p`` sets every body; a parameters
-file one (key ``/<name>/attitude_simulator``) or all (``/**/attitude_simulator``).
-The process saves an interpreter and a DDS participant per body, and by
-default steps every body on one engine :class:`~rigid_body_dynamics.engine.Loop`
-thread that publishes within a budget between integration passes (a thread
-per body, measured in benchmarks/bodies.py, carried 4 bodies where this
-carries 48, and was removed). At most one body may publish /clock; bodies that
-share their frames do not broadcast /tf. A body at ``real_time_factor`` 0
-makes the others late: as-fast-as-possible runs belong in their own process.
+Every body is an ``AttitudeSimulator`` in ``/<name>``, with the topics, services, parameters
+and diagnostics of ``attitude_simulator --ros-args -r __ns:=/<name>``. ``-p`` sets every body,
+a parameters file one (``/<name>/attitude_simulator``) or all (``/**/attitude_simulator``).
+One interpreter, one DDS participant and one engine Loop thread serve all bodies, publishing
+within a budget between integration passes (benchmarks/bodies.py). At most one body may
+publish /clock; bodies sharing their frames do not broadcast /tf; an as-fast-as-possible body
+makes the others late (run it in its own process).
 
 ``attitude_fleet [--bodies N] [--prefix body] [--names a,b,...] [--ros-args ...]``
 """
@@ -26,18 +22,17 @@ from rclpy.utilities import remove_ros_args
 
 from .simulator import AttitudeSimulator, DIAGNOSTIC_PERIOD, integration_loop, NODE_NAME
 from .simulator import SWITCH_INTERVAL
-from ..engine import Loop
-from ..engine.loop import FLEET_PUBLISH_BUDGET
+from ..engine.loop import FLEET_PUBLISH_BUDGET, Loop
 from ..ros.parameters import ConfigurationError
 from ..ros.runner import run
 
 
 def body_names(bodies, prefix, names):
     """Namespaces of the bodies: ``names`` (comma-separated) or prefix1 ... prefixN."""
-    if names:
-        out = [n.strip().strip('/') for n in names.split(',')]
-    else:
-        out = [f'{prefix}{k}' for k in range(1, bodies + 1)]
+    out = ([n.strip().strip('/') for n in names.split(',')] if names else
+           [f'{prefix}{k}' for k in range(1, bodies + 1)])
+    if not names and bodies < 1:
+        raise ConfigurationError('--bodies must be at least 1')
     if not out or any(not n for n in out):
         raise ConfigurationError(f'no valid body names in {names!r}')
     if len(set(out)) != len(out):
@@ -74,11 +69,9 @@ class Fleet:
 
     def _untangle_tf(self):
         """Stop /tf for bodies whose (world, body) frames another body also broadcasts."""
-        frames = collections.Counter(
-            n.state.world_frame + ' -> ' + n.state.body_frame
-            for n in self.nodes if n.state.broadcasts_tf)
-        shared = [n for n in self.nodes
-                  if frames[n.state.world_frame + ' -> ' + n.state.body_frame] > 1]
+        pairs = {n: f'{n.state.world_frame} -> {n.state.body_frame}' for n in self.nodes}
+        frames = collections.Counter(pairs[n] for n in self.nodes if n.state.broadcasts_tf)
+        shared = [n for n in self.nodes if frames[pairs[n]] > 1]
         for node in shared:
             node.state.stop_tf(node)
         if shared:
@@ -99,7 +92,7 @@ class Fleet:
         self._thread.start()
 
     def stop(self):
-        """Stop the integration thread(s) and wait for them."""
+        """Stop the integration thread and wait for it."""
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
@@ -117,15 +110,12 @@ def main(args=None, early=None):
     parser.add_argument('--names', default='',
                         help='comma-separated namespaces instead of --bodies/--prefix')
     options = parser.parse_args(remove_ros_args(argv)[1:])
-    if options.bodies < 1 and not options.names:
-        parser.error('--bodies must be at least 1')
     try:
         names = body_names(options.bodies, options.prefix, options.names)
     except ConfigurationError as err:
         parser.error(str(err))
-    return run(lambda: Fleet(names), NODE_NAME, argv,
-               early=early, on_start=lambda fleet: fleet.start(),
-               on_stop=lambda fleet: fleet.stop())
+    return run(lambda: Fleet(names), NODE_NAME, argv, early=early,
+               on_start=Fleet.start, on_stop=Fleet.stop)
 
 
 if __name__ == '__main__':
