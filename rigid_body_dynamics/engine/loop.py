@@ -20,6 +20,8 @@ import time
 
 #: Longest sleep of one cycle (s), so that diagnostics and stopping stay prompt.
 LONGEST_WAIT = 0.05
+#: Longest time (s) a member is not looked at because its next step is not due.
+LOOK_AGAIN = 0.005
 #: attitude_fleet's budget (s) of publishing between integration passes: one body's tick
 #: (7 messages) takes about 0.5 ms to publish, a step 10-30 us to integrate, so publishing
 #: every body at one tick in a row would make the last bodies' next steps several ms late.
@@ -47,6 +49,7 @@ class Loop:
         self.clock, self.perf = clock, perf
         self.pending = collections.deque()     # (member, item or None = diagnostics)
         self._outbox = []
+        self._due_at = [-math.inf] * len(self.members)   # when each member has a step due
         self._next_diagnostics = clock() + self.period if self.period else math.inf
 
     def cycle(self):
@@ -57,8 +60,16 @@ class Loop:
             self._next_diagnostics = max(self._next_diagnostics + self.period, now)
             pending.extend((m, None) for m in self.members if m.diagnostics is not None)
         wait = math.inf
-        for member in self.members:
-            wait = min(wait, member.pace.due(outbox))
+        due_at = self._due_at
+        for k, member in enumerate(self.members):
+            if now < due_at[k]:               # nothing due yet: not even a look
+                wait = min(wait, due_at[k] - now)
+                continue
+            member_wait = member.pace.due(outbox)
+            # skip the member until its next step, but look at least every LOOK_AGAIN s
+            # (a resume, reset or rate change can move that step earlier)
+            due_at[k] = now + min(member_wait, LOOK_AGAIN) if member_wait > 0.0 else -math.inf
+            wait = min(wait, member_wait)
             member.log_notes()
             if outbox:
                 pending.extend((member, item) for item in outbox)

@@ -35,9 +35,9 @@ class Pace:
     counts steps computed more than LATE_LIMIT after their deadline,
     ``max_late_ns`` the worst lateness since :meth:`take_max_late`;
     ``on_backlog(steps)`` is called when a backlog over MAX_LAG is dropped;
-    ``take_commands()``, if given, at the start of every :meth:`due` (a node
-    takes the pending torque commands there, so they are used from the next
-    step on, with no executor between).
+    ``take_commands()``, if given, in :meth:`due` before steps that are due
+    (a node takes the pending torque commands there, so they are used from
+    the next step on, with no executor between).
     """
 
     def __init__(self, body, rtf, clock=time.monotonic_ns, perf=time.perf_counter,
@@ -76,12 +76,11 @@ class Pace:
         Returns the wall time (s) until the next step is due.
         """
         body = self.body
-        if self.take_commands is not None:
-            self.take_commands()
         with body.lock:
             if body.paused:
                 return PAUSED_WAIT
             if self.rtf == 0.0:
+                self._take()
                 end = self.perf() + AFAP_BATCH
                 while self.perf() < end:
                     body.advance(self.clock(), outbox)
@@ -99,10 +98,15 @@ class Pace:
                     self.on_backlog(behind)
                     self.anchor()
                     behind = 1
+                self._take()                  # the commands that came, before the steps
                 for _ in range(behind):
                     body.advance(now, outbox)
             next_due = self.anchor_ns + (body.steps + 1 - self.anchor_steps) * period
             return max(0.0, (next_due - self.clock()) / _NS)
+
+    def _take(self):
+        if self.take_commands is not None:
+            self.take_commands()
 
     def achieved(self):
         """Return the achieved real-time factor (simulated s per wall s) since the last call."""

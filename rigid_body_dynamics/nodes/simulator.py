@@ -325,6 +325,8 @@ class AttitudeSimulator(Node):
 
     def log_notes(self):
         """Log what the body noted while stepping (the watchdog's timeouts)."""
+        if not self.body.notes:           # (read without the lock: a list's truth is atomic)
+            return
         for note in self.body.take_notes():
             self.get_logger().info(note)
 

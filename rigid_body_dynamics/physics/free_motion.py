@@ -140,7 +140,8 @@ class PolhodeParameters:
         pi_r = sn * xp.special(elliprf, cn2, dn2, 1.0) + n / 3.0 * sn ** 3 * xp.special(
             elliprj, cn2, dn2, 1.0, 1.0 - n * sn * sn)
         value = pi_r - (self.alpha / c) * (r + xp.atan2((c - 1.0) * sn * cn, cn2 + c * sn * sn))
-        if np.any(j != 0.0):
+        # (a numpy reduction on a float costs ~4 us a step: test a float as a float)
+        if (np.any(j != 0.0) if isinstance(j, np.ndarray) else j != 0.0):
             value = value + j * (2.0 * self.complete_pi - self.alpha * math.pi / c)
         return value
 
