@@ -51,8 +51,7 @@ class Fleet:
         try:
             for name in names:
                 self.nodes.append(AttitudeSimulator(namespace='/' + name, **kwargs))
-            clocks = [n.get_namespace() for n in self.nodes if n.get_parameter(
-                'publish_clock').value]
+            clocks = [n.get_namespace() for n in self.nodes if n.publishes_clock]
             if len(clocks) > 1:
                 raise ConfigurationError(
                     f'publish_clock is set for {len(clocks)} bodies ({", ".join(clocks[:3])}'
@@ -64,8 +63,7 @@ class Fleet:
             raise
         self._untangle_tf()
         self.context = self.nodes[0].context     # one context, shared by every body
-        self._logger.info(f'{len(self.nodes)} bodies in this process ({", ".join(names[:5])}'
-                          f'{", ..." if len(names) > 5 else ""}), one integration thread')
+        self._logger.info(f'{len(names)} bodies in this process, one integration thread')
 
     def _untangle_tf(self):
         """Stop /tf for bodies whose (world, body) frames another body also broadcasts."""

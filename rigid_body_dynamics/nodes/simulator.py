@@ -310,6 +310,11 @@ class AttitudeSimulator(Node):
                   self.context))
         self._thread.start()
 
+    @property
+    def publishes_clock(self):
+        """Whether this body publishes /clock (``publish_clock``)."""
+        return self._publish_clock
+
     def member(self, diagnostics=False):
         """Return this body as a member of an engine Loop (diagnostics: the Loop sends them)."""
         return Member(self.pace, self.state.publish, self.log_notes,
