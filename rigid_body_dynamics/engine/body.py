@@ -157,7 +157,7 @@ class BodySimulation:
             self.paused = False
             self.command_held = None
             self.timed_out = False
-            self.last_torque = _ZERO
+            self._held = (_ZERO, None, None)
             self.gyro = GyroModel(self.gyro_errors, self.rate / max(self.imu_every, 1),
                                   self.seed)     # same seed: the same stream after a reset
             self._disturb()
@@ -367,15 +367,9 @@ class BodySimulation:
             self._baseline()          # the state after the last step under torque
         self.stepper.step(torque, torque_world, field)
         self.steps += 1
-        q = self.stepper.q
-        if torque_world is not None:
-            w = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), torque_world)
-            torque = (torque[0] + w[0], torque[1] + w[1], torque[2] + w[2])
-        if field is not None:      # the field's torque at the end of the step
-            f = field(self.stepper.time, *q)
-            torque = (torque[0] + f[0], torque[1] + f[1], torque[2] + f[2])
         self._base_stale = self._base_stale or bool(torqued)
-        self.last_torque = torque
+        # the body torque of this step, in full only when a snapshot asks (not every step)
+        self._held = (torque, torque_world, field)
         if self.steps % self.publish_every == 0:
             outbox.append(self.snapshot())
         if self.imu_every and self.steps % self.imu_every == 0:
@@ -400,6 +394,24 @@ class BodySimulation:
     def stamp_now(self):
         """Return the stamp (int ns) of the current simulated time."""
         return self.start_ns + int(self.steps * self.dt_ns)
+
+    @property
+    def last_torque(self):
+        """
+        Principal-frame body torque (N m) of the last step, as reported (zero before one).
+
+        The held body part, plus the world part and the field (gravity gradient)
+        evaluated at the state at the end of the step.
+        """
+        torque, torque_world, field = self._held
+        q = self.stepper.q
+        if torque_world is not None:
+            w = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), torque_world)
+            torque = (torque[0] + w[0], torque[1] + w[1], torque[2] + w[2])
+        if field is not None:
+            f = field(self.stepper.time, *q)
+            torque = (torque[0] + f[0], torque[1] + f[1], torque[2] + f[2])
+        return torque
 
     def snapshot(self, odom_only=False):
         """Take the current :class:`Snapshot` (call under ``lock``)."""
