@@ -126,7 +126,7 @@ ASYMMETRIC_SETUPS = (
 )
 
 
-def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128, 160)):
+def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128, 160, 192, 256)):
     """
     Fleets of asymmetric bodies: what limits the count, what to switch off.
 

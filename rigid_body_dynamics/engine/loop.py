@@ -15,6 +15,7 @@ No ROS here: the callables are the nodes'; tests drive it on a fake clock.
 
 import collections
 from dataclasses import dataclass
+import heapq
 import math
 import time
 
@@ -49,7 +50,9 @@ class Loop:
         self.clock, self.perf = clock, perf
         self.pending = collections.deque()     # (member, item or None = diagnostics)
         self._outbox = []
-        self._due_at = [-math.inf] * len(self.members)   # when each member has a step due
+        # (when a member is to be looked at, its index): a heap, so that a cycle touches only
+        # the members that are due, not all N (at 96 bodies that loop was 9 % of the thread)
+        self._due = [(-math.inf, k) for k in range(len(self.members))]
         self._next_diagnostics = clock() + self.period if self.period else math.inf
 
     def cycle(self):
@@ -59,21 +62,21 @@ class Loop:
         if now >= self._next_diagnostics:
             self._next_diagnostics = max(self._next_diagnostics + self.period, now)
             pending.extend((m, None) for m in self.members if m.diagnostics is not None)
-        wait = math.inf
-        due_at = self._due_at
-        for k, member in enumerate(self.members):
-            if now < due_at[k]:               # nothing due yet: not even a look
-                wait = min(wait, due_at[k] - now)
-                continue
+        due, members, looked = self._due, self.members, []
+        while due and due[0][0] <= now:
+            k = heapq.heappop(due)[1]
+            member = members[k]
             member_wait = member.pace.due(outbox)
-            # skip the member until its next step, but look at least every LOOK_AGAIN s
-            # (a resume, reset or rate change can move that step earlier)
-            due_at[k] = now + min(member_wait, LOOK_AGAIN) if member_wait > 0.0 else -math.inf
-            wait = min(wait, member_wait)
+            # look again at its next step, but at least every LOOK_AGAIN s (a resume, reset
+            # or rate change can move that step earlier); at once if a step is due now
+            looked.append((now + min(member_wait, LOOK_AGAIN) if member_wait > 0.0 else now, k))
             member.log_notes()
             if outbox:
                 pending.extend((member, item) for item in outbox)
                 outbox.clear()
+        for entry in looked:
+            heapq.heappush(due, entry)
+        wait = due[0][0] - now if due else math.inf
         end = self.perf() + self.budget
         backlog = 3 * len(self.members)
         while pending and (self.perf() < end or len(pending) > backlog):
