@@ -8,7 +8,7 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 ``--only nodes`` skips the physics sections; ``--only torque`` runs the
 torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak |
 soak-rt | flood | bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep |
-latency``
+latency | publish``
 runs one reliability / scale measurement (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
@@ -48,7 +48,8 @@ def main():
     parser.add_argument('--nodes', action='store_true', help='also the simulator node')
     parser.add_argument('--only', choices=['nodes', 'torque', 'soak', 'soak-rt', 'flood',
                                            'bodies', 'hosts', 'analyzer-memory', 'bag',
-                                           'lockstep', 'bodies-asymmetric', 'latency'],
+                                           'lockstep', 'bodies-asymmetric', 'latency',
+                                           'publish'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -106,6 +107,7 @@ SCALE = {
     'lockstep': ('lockstep', 'Lockstep closed loop: throughput and period'),
     'bodies-asymmetric': ('bodies_asymmetric', 'Many asymmetric bodies in fleets'),
     'latency': ('latency', 'Torque command to published state, against the relay floor'),
+    'publish': ('publish', 'Publishing serialised state'),
 }
 
 

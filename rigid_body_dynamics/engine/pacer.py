@@ -53,8 +53,18 @@ class Pace:
         self._stats = (clock(), body.steps)
 
     def anchor(self):
-        """Restart the schedule: the next step is due one period from now."""
-        self.anchor_ns = self.clock()
+        """
+        Restart the schedule: the next step is due at the next whole period of the clock.
+
+        The anchor is the last multiple of the step period (wall ns) on the steady
+        clock, so the bodies of one thread with the same period are due at the same
+        instants and one wake-up steps them all (a wake-up per body and step cost a
+        fleet of 96 bodies more than their steps). The first step comes at most one
+        period after this call.
+        """
+        now = self.clock()
+        period = self.body.dt_ns / self.rtf if self.rtf > 0.0 else self.body.dt_ns
+        self.anchor_ns = now - now % period
         self.anchor_steps = self.body.steps
 
     def restart(self):

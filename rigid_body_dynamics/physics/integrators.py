@@ -236,7 +236,8 @@ class ExactIntegrator(Integrator):
 
     Torque-free steps evaluate the closed-form flow from the start of the
     torque-free segment (``time`` since then), so T and L stay at round-off
-    however long the segment. A step under torque is one explicit RK step of
+    however long the segment; they do so when q or omega is read, so a step
+    that nobody reads costs only its count. A step under torque is one explicit RK step of
     the seven-state system: Butcher's order-6 method while rho h <=
     ``ORDER6_LIMIT``, else DOP853's order-8 formula, in n equal sub-steps with
     rho h / n <= ``ORDER8_LIMIT``; rho = |omega| + sqrt(max |tau_i| / I_min)
@@ -260,6 +261,8 @@ class ExactIntegrator(Integrator):
     _kernels = {mode: (KERNELS[(6, mode)], KERNELS[(8, mode)])
                 for mode in ('free', 'body', 'world', 'field')}
 
+    _lazy = False       # whether q and omega are still to be read off the free flow
+
     def _reset(self):
         if not hasattr(self, '_shape'):
             self._shape = BodyShape(self.moments)
@@ -278,12 +281,47 @@ class ExactIntegrator(Integrator):
         if self._segment is _RK_SEGMENT:
             self._rk('free', None, None, 0.0)
             return
+        # The state after this step is the flow at the step count: evaluated when q or
+        # omega is read (a snapshot, a torque step, diagnostics), not at every step. The
+        # same closed form at the same time, so the same numbers, bit for bit.
+        self._lazy = True
+
+    # q and omega: plain attributes in the other integrators; here read through the flow
+    @property
+    def q(self):
+        """Attitude (x, y, z, w), principal frame -> world, after the steps so far."""
+        if self._lazy:
+            self._evaluate()
+        return self._q
+
+    @q.setter
+    def q(self, value):
+        if self._lazy:             # (set alone, omega would be the flow's: fix it first)
+            self._evaluate()
+        self._q = value
+
+    @property
+    def omega(self):
+        """Angular velocity (rad/s, principal frame) after the steps so far."""
+        if self._lazy:
+            self._evaluate()
+        return self._omega
+
+    @omega.setter
+    def omega(self, value):
+        if self._lazy:
+            self._evaluate()
+        self._omega = value
+
+    def _evaluate(self):
+        """Put the free flow's state at the current step count into q and omega."""
+        self._lazy = False
         flow, start = self._segment
-        q, m = flow.state((self.steps + 1 - start) * self.dt)
+        q, m = flow.state((self.steps - start) * self.dt)
         r = 1.0 / math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-        self.q = (float(q[0]) * r, float(q[1]) * r, float(q[2]) * r, float(q[3]) * r)
+        self._q = (float(q[0]) * r, float(q[1]) * r, float(q[2]) * r, float(q[3]) * r)
         i1, i2, i3 = self.moments
-        self.omega = (float(m[0]) / i1, float(m[1]) / i2, float(m[2]) / i3)
+        self._omega = (float(m[0]) / i1, float(m[1]) / i2, float(m[2]) / i3)
 
     def _torque_step(self, torque, torque_world):
         self._segment = None
