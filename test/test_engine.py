@@ -296,6 +296,66 @@ def test_loop_publishes_within_its_budget_and_schedules_diagnostics():
     assert 0.0 < loop.cycle() <= 0.05                    # sleeps until the next step, capped
 
 
+def test_loop_looks_only_at_due_members_and_at_once_at_a_moved_schedule():
+    """
+    engine.Loop: a member is looked at when its step is due, not before; a resume re-anchors.
+
+    One body paused (its pace says: look again in PAUSED_WAIT), one running at 1 kHz:
+    while paused the first is not stepped; after resume + anchor (what the node's pause
+    service does) it is stepped at its next step, long before PAUSED_WAIT is over.
+    """
+    from rigid_body_dynamics.engine import Loop, Member
+    from rigid_body_dynamics.engine.pacer import PAUSED_WAIT
+    clock = FakeClock()
+    bodies = [make_body(publish_every=1000) for _ in range(2)]
+    paces = [Pace(b, 1.0, clock=clock, perf=clock.perf) for b in bodies]
+    calls = [0, 0]
+
+    def counting(k):
+        due = paces[k].due
+
+        def wrapped(outbox):
+            calls[k] += 1
+            return due(outbox)
+        return wrapped
+    for k, pace in enumerate(paces):
+        pace.due = counting(k)
+    loop = Loop([Member(p, lambda item: None) for p in paces],
+                clock=lambda: clock.ns / 1e9, perf=clock.perf)
+    bodies[0].set_paused(True)
+    for _ in range(20):                         # 20 ms in 1 ms cycles
+        clock.advance(MS)
+        loop.cycle()
+    assert bodies[0].steps == 0 and bodies[1].steps == 20
+    assert calls[0] == 1 and calls[1] == 20     # the paused body: one look, not twenty
+    bodies[0].set_paused(False)
+    paces[0].anchor()
+    clock.advance(MS)
+    loop.cycle()                     # the move is seen: looked at, and its first step is due
+    assert calls[0] == 2 and bodies[0].steps == 1
+    clock.advance(MS)
+    loop.cycle()
+    assert bodies[0].steps == 2 and bodies[1].steps == 22
+    assert 2 * MS < PAUSED_WAIT * 1e9     # (so the steps came from the move, not a late look)
+
+
+def test_paces_anchor_on_whole_periods_and_spread_over_phases():
+    """Steps fall on whole periods of the clock plus the phase; 40 bodies: 3 phases."""
+    from rigid_body_dynamics.engine.pacer import spread_phases
+    clock = FakeClock()
+    clock.advance(0.3 * MS)                       # between two whole periods of 1 ms
+    paces = [Pace(make_body(), 1.0, clock=clock, perf=clock.perf) for _ in range(40)]
+    assert {p.anchor_ns % MS for p in paces} == {0}
+    spread_phases(paces)
+    assert sorted({p.phase for p in paces}) == pytest.approx([0.0, 1 / 3, 2 / 3])
+    assert sum(p.phase == 0.0 for p in paces) == 14      # at most 16 due at one instant
+    for p in paces:
+        assert (p.anchor_ns - p.phase * MS) % MS == pytest.approx(0.0, abs=1e-3)
+        assert 0 <= clock.ns - p.anchor_ns < MS            # the first step within a period
+    with pytest.raises(ValueError, match='phase'):
+        paces[0].set_phase(1.0)
+
+
 def test_a_batch_of_commands_counts_and_holds_as_one_by_one():
     """command_batch: the counters and the held command equal command() called per message."""
     rng = np.random.default_rng(5)

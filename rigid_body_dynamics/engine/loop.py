@@ -15,14 +15,13 @@ No ROS here: the callables are the nodes'; tests drive it on a fake clock.
 
 import collections
 from dataclasses import dataclass
+import functools
 import heapq
 import math
 import time
 
 #: Longest sleep of one cycle (s), so that diagnostics and stopping stay prompt.
 LONGEST_WAIT = 0.05
-#: Longest time (s) a member is not looked at because its next step is not due.
-LOOK_AGAIN = 0.005
 #: attitude_fleet's budget (s) of publishing between integration passes: one body's tick
 #: (7 messages) takes about 0.5 ms to publish, a step 10-30 us to integrate, so publishing
 #: every body at one tick in a row would make the last bodies' next steps several ms late.
@@ -51,8 +50,14 @@ class Loop:
         self.pending = collections.deque()     # (member, item or None = diagnostics)
         self._outbox = []
         # (when a member is to be looked at, its index): a heap, so that a cycle touches only
-        # the members that are due, not all N (at 96 bodies that loop was 9 % of the thread)
+        # the members that are due, not all N (at 96 bodies that loop was 9 % of the thread).
+        # An entry is current while it equals _next[k]; older ones are dropped when popped.
         self._due = [(-math.inf, k) for k in range(len(self.members))]
+        self._next = [-math.inf] * len(self.members)
+        # members whose schedule moved (reset, resume, new rate: Pace.anchor): look at once
+        self._moved = collections.deque()
+        for k, member in enumerate(self.members):
+            member.pace.on_anchor = functools.partial(self._moved.append, k)
         self._next_diagnostics = clock() + self.period if self.period else math.inf
 
     def cycle(self):
@@ -62,19 +67,25 @@ class Loop:
         if now >= self._next_diagnostics:
             self._next_diagnostics = max(self._next_diagnostics + self.period, now)
             pending.extend((m, None) for m in self.members if m.diagnostics is not None)
-        due, members, looked = self._due, self.members, []
+        due, members, looked, upcoming = self._due, self.members, [], self._next
+        moved = self._moved
+        while moved:                       # (appended by other threads: popped one by one)
+            k = moved.popleft()
+            upcoming[k] = now
+            heapq.heappush(due, (now, k))
         while due and due[0][0] <= now:
-            k = heapq.heappop(due)[1]
+            at, k = heapq.heappop(due)
+            if at != upcoming[k]:
+                continue                   # superseded by a move
             member = members[k]
             member_wait = member.pace.due(outbox)
-            # look again at its next step, but at least every LOOK_AGAIN s (a resume, reset
-            # or rate change can move that step earlier); at once if a step is due now
-            looked.append((now + min(member_wait, LOOK_AGAIN) if member_wait > 0.0 else now, k))
+            looked.append((now + member_wait, k))   # its next step (or at once, if 0)
             member.log_notes()
             if outbox:
                 pending.extend((member, item) for item in outbox)
                 outbox.clear()
         for entry in looked:
+            upcoming[entry[1]] = entry[0]
             heapq.heappush(due, entry)
         wait = due[0][0] - now if due else math.inf
         end = self.perf() + self.budget

@@ -25,6 +25,10 @@ AFAP_BATCH = 0.005
 AFAP_YIELD = 0.0002
 #: Wait (s) while the body is paused.
 PAUSED_WAIT = 0.05
+#: Bodies of one thread due at one instant (:func:`spread_phases`): a body's step and its
+#: publishing cost 40-50 us in a fleet of 96, so 16 at once keep a burst near 1 ms; all 96
+#: at once took 4-5 ms and made the last ones late.
+PHASE_BODIES = 16
 
 
 class Pace:
@@ -49,23 +53,37 @@ class Pace:
         self.on_backlog = on_backlog or (lambda steps: None)
         self.missed = 0
         self.max_late_ns = 0
+        self.phase = 0.0
+        self.on_anchor = None       # called by anchor(): an engine Loop sets it
         self.anchor()
         self._stats = (clock(), body.steps)
 
     def anchor(self):
         """
-        Restart the schedule: the next step is due at the next whole period of the clock.
+        Restart the schedule: the next step is due at the next slot of the clock.
 
-        The anchor is the last multiple of the step period (wall ns) on the steady
-        clock, so the bodies of one thread with the same period are due at the same
-        instants and one wake-up steps them all (a wake-up per body and step cost a
-        fleet of 96 bodies more than their steps). The first step comes at most one
-        period after this call.
+        Steps fall on whole periods of the steady clock, shifted by ``phase``
+        periods (0 <= phase < 1), so the bodies of one thread with the same
+        period and phase are due at the same instants and one wake-up steps
+        them all: a wake-up per body and step cost a fleet of 96 bodies more
+        than their steps, and all 96 at one instant made the last ones late
+        (attitude_fleet spreads its bodies over a few phases). The first step
+        comes at most one period after this call.
         """
         now = self.clock()
         period = self.body.dt_ns / self.rtf if self.rtf > 0.0 else self.body.dt_ns
-        self.anchor_ns = now - now % period
+        offset = self.phase * period
+        self.anchor_ns = now - (now - offset) % period
         self.anchor_steps = self.body.steps
+        if self.on_anchor is not None:
+            self.on_anchor()             # tell the Loop: the next step may be earlier now
+
+    def set_phase(self, phase):
+        """Shift the step instants by ``phase`` periods (0 <= phase < 1; re-anchors)."""
+        if not 0.0 <= phase < 1.0:
+            raise ValueError(f'phase must be in [0, 1), got {phase!r}')
+        self.phase = float(phase)
+        self.anchor()
 
     def restart(self):
         """After a reset of the body: a new anchor and no lateness counted so far."""
@@ -131,3 +149,16 @@ class Pace:
         with self.body.lock:
             late, self.max_late_ns = self.max_late_ns, 0
         return late / 1e6
+
+
+def spread_phases(paces, per_phase=PHASE_BODIES):
+    """
+    Spread ``paces`` over ceil(N / per_phase) equally spaced phases of their step period.
+
+    So that one thread's N bodies are due in groups of at most ``per_phase``: one
+    wake-up per group and step, not per body, and no burst of all N at once.
+    """
+    paces = list(paces)
+    phases = max(1, -(-len(paces) // per_phase))
+    for k, pace in enumerate(paces):
+        pace.set_phase((k % phases) / phases)

@@ -4,10 +4,9 @@ attitude_fleet: many bodies in one process, each a full attitude_simulator in it
 Every body is an ``AttitudeSimulator`` in ``/<name>``, with the topics, services, parameters
 and diagnostics of ``attitude_simulator --ros-args -r __ns:=/<name>``. ``-p`` sets every body,
 a parameters file one (``/<name>/attitude_simulator``) or all (``/**/attitude_simulator``).
-One interpreter, one DDS participant and one engine Loop thread serve all bodies, publishing
-within a budget between integration passes (benchmarks/bodies.py). At most one body may
-publish /clock; bodies sharing their frames do not broadcast /tf; an as-fast-as-possible body
-makes the others late (run it in its own process).
+One interpreter, one DDS participant and one engine Loop thread serve all bodies (benchmarks/
+bodies.py). One body at most publishes /clock; bodies sharing frames do not broadcast /tf; an
+as-fast-as-possible body makes the others late (run it in its own process).
 
 ``attitude_fleet [--bodies N] [--prefix body] [--names a,b,...] [--ros-args ...]``
 """
@@ -23,6 +22,7 @@ from rclpy.utilities import remove_ros_args
 from .simulator import AttitudeSimulator, DIAGNOSTIC_PERIOD, integration_loop, NODE_NAME
 from .simulator import SWITCH_INTERVAL
 from ..engine.loop import FLEET_PUBLISH_BUDGET, Loop
+from ..engine.pacer import spread_phases
 from ..ros.parameters import ConfigurationError
 from ..ros.runner import run
 
@@ -45,9 +45,7 @@ class Fleet:
 
     def __init__(self, names, **kwargs):
         self._logger = rclpy.logging.get_logger('attitude_fleet')
-        self.nodes = []
-        self._stop = threading.Event()
-        self._thread = None
+        self.nodes, self._stop, self._thread = [], threading.Event(), None
         try:
             for name in names:
                 self.nodes.append(AttitudeSimulator(namespace='/' + name, **kwargs))
@@ -81,6 +79,7 @@ class Fleet:
     def start(self):
         """Start the thread that steps every body (diagnostics too: no timer per body)."""
         sys.setswitchinterval(SWITCH_INTERVAL)
+        spread_phases(node.pace for node in self.nodes)     # a few bodies due at a time
         loop = Loop([node.member(diagnostics=True) for node in self.nodes],
                     publish_budget=FLEET_PUBLISH_BUDGET, diagnostics_period=DIAGNOSTIC_PERIOD)
         priority = max(node.thread_priority for node in self.nodes)
