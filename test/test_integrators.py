@@ -285,30 +285,26 @@ def test_exact_free_state_read_late_is_the_state_read_every_step(moments, rng):
     """
     A torque-free exact step only counts; q and omega are the flow's when read.
 
-    Reading them after every step, every 10th (with an off-pattern read in between,
-    as diagnostics do) or only at the end, across a torque pulse that reads the state
-    it starts from, gives the same state to an ulp or two (the flow is evaluated ahead
-    in chunks, in one numpy call, or alone) and the exact motion after the pulse.
+    Reading them after every step or only at the end (and across torque pulses, which
+    read the state they start from) gives the same numbers bit for bit, and the
+    diagnostics' invariants come from the state at the current step.
     """
     q0 = random_attitude(rng)
-    every, tenth, late = (make_integrator('exact', moments, 1e-3, q0, OMEGA0)
-                          for _ in range(3))
+    every = make_integrator('exact', moments, 1e-3, q0, OMEGA0)
+    late = make_integrator('exact', moments, 1e-3, q0, OMEGA0)
     seen = []
     for k in range(3000):
         torque = (0.0, 0.2, 0.0) if 1000 <= k < 1010 else (0.0, 0.0, 0.0)
-        for stepper in (every, tenth, late):
-            stepper.step(torque)
+        every.step(torque)
+        late.step(torque)
         seen.append((every.q, every.omega))
-        if k % 10 == 0 or k % 97 == 0:
-            np.testing.assert_allclose(tenth.q, every.q, rtol=0, atol=2e-15)
-            np.testing.assert_allclose(tenth.omega, every.omega, rtol=0, atol=2e-15)
-    for stepper in (tenth, late):
-        np.testing.assert_allclose(stepper.q, seen[-1][0], rtol=0, atol=2e-15)
-        np.testing.assert_allclose(stepper.omega, seen[-1][1], rtol=0, atol=2e-15)
-        assert stepper.work == pytest.approx(every.work, rel=1e-12)
-        np.testing.assert_allclose(stepper.impulse, every.impulse, rtol=1e-12)
+        if k == 2500:
+            assert late.kinetic_energy == every.kinetic_energy
+    assert (late.q, late.omega) == seen[-1]
+    assert late.angular_momentum_world == every.angular_momentum_world
+    assert late.work == every.work and late.impulse == every.impulse
     # reading never moves the state: the same numbers however often it is read
-    assert (late.q, late.omega) == (late.q, late.omega)
+    assert (late.q, late.omega) == (late.q, late.omega) == seen[-1]
     q_exact, w_exact = FreeRigidBody(moments, seen[1009][1], seen[1009][0]).state_at(1.99)
     assert float(quaternions.angle_between(late.q, q_exact)) < 1e-12
     np.testing.assert_allclose(late.omega, w_exact, atol=1e-12)

@@ -37,8 +37,6 @@ step measured and cheaper (benchmarks/RESULTS.md, torque section).
 from abc import ABC, abstractmethod
 import math
 
-import numpy as np
-
 from .free_motion import BodyShape
 from .quaternions import rotate_components
 from .rk_kernels import KERNELS
@@ -264,8 +262,6 @@ class ExactIntegrator(Integrator):
                 for mode in ('free', 'body', 'world', 'field')}
 
     _lazy = False       # whether q and omega are still to be read off the free flow
-    #: States of the free flow evaluated ahead in one call (see :meth:`_evaluate`).
-    CHUNK = 64
 
     def _reset(self):
         if not hasattr(self, '_shape'):
@@ -275,8 +271,6 @@ class ExactIntegrator(Integrator):
         # the torque-free segment: None (starts at the next free step), (flow, start step),
         # or _RK_SEGMENT near the separatrix (free motion keeps S, so it stays near it)
         self._segment = None
-        self._chunk = None             # (flow, first step, stride, [(q, omega), ...])
-        self._last_read = 0            # the step count at the last read of the state
         self._torque_key = None        # the torque whose time scale is cached below
         self._torque_rate = 0.0        # sqrt(max |tau_i| / I_min), 1/s
 
@@ -320,51 +314,14 @@ class ExactIntegrator(Integrator):
         self._omega = value
 
     def _evaluate(self):
-        """
-        Put the free flow's state at the current step count into q and omega.
-
-        The flow is evaluated ahead, in one numpy call, at the next CHUNK steps at
-        which the state is expected to be read (the stride of the last two reads:
-        every publish tick), and served from there: 1.5-2 us a read instead of
-        10-12 us for the elliptic solution one time at a time. A read off that
-        pattern (diagnostics) is evaluated alone. Chunk and single reads are the
-        same closed form at the same time, equal to within an ulp or two.
-        """
+        """Put the free flow's state at the current step count into q and omega."""
         self._lazy = False
         flow, start = self._segment
-        k = self.steps - start
-        stride = max(1, self.steps - self._last_read)
-        self._last_read = self.steps
-        chunk = self._chunk
-        if chunk is not None and chunk[0] is flow:
-            _, k0, step, states = chunk
-            j, off = divmod(k - k0, step)
-            if 0 <= j < len(states):
-                if off == 0:
-                    self._q, self._omega = states[j]
-                    return
-                self._q, self._omega = self._states(flow, float(k * self.dt))
-                return
-            if (k - k0) % step == 0:
-                stride = step                   # the same pattern, further on
-        ks = k + stride * np.arange(self.CHUNK)
-        states = self._states(flow, ks * self.dt)
-        self._chunk = (flow, k, stride, states)
-        self._q, self._omega = states[0]
-
-    def _states(self, flow, t):
-        """(q, omega) tuples of floats of ``flow`` at t (s): one pair, or a list for an array."""
-        q, m = flow.state(t)
+        q, m = flow.state((self.steps - start) * self.dt)
+        r = 1.0 / math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+        self._q = (float(q[0]) * r, float(q[1]) * r, float(q[2]) * r, float(q[3]) * r)
         i1, i2, i3 = self.moments
-        if isinstance(t, float):
-            r = 1.0 / math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-            return ((float(q[0]) * r, float(q[1]) * r, float(q[2]) * r, float(q[3]) * r),
-                    (float(m[0]) / i1, float(m[1]) / i2, float(m[2]) / i3))
-        q = [np.broadcast_to(c, t.shape) for c in q]
-        r = 1.0 / np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-        qs = zip(*((c * r).tolist() for c in q))
-        ws = zip(*(np.broadcast_to(c / i, t.shape).tolist() for c, i in zip(m, (i1, i2, i3))))
-        return list(zip(qs, ws))
+        self._omega = (float(m[0]) / i1, float(m[1]) / i2, float(m[2]) / i3)
 
     def _torque_step(self, torque, torque_world):
         self._segment = None
