@@ -8,7 +8,7 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 ``--only nodes`` skips the physics sections; ``--only torque`` runs the
 torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak |
 soak-rt | flood | bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep |
-latency | publish``
+latency | publish | flow-batch``
 runs one reliability / scale measurement (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
@@ -49,7 +49,7 @@ def main():
     parser.add_argument('--only', choices=['nodes', 'torque', 'soak', 'soak-rt', 'flood',
                                            'bodies', 'hosts', 'analyzer-memory', 'bag',
                                            'lockstep', 'bodies-asymmetric', 'latency',
-                                           'publish'],
+                                           'publish', 'flow-batch'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -108,6 +108,7 @@ SCALE = {
     'bodies-asymmetric': ('bodies_asymmetric', 'Many asymmetric bodies in fleets'),
     'latency': ('latency', 'Torque command to published state, against the relay floor'),
     'publish': ('publish', 'Publishing serialised state'),
+    'flow-batch': ('flow_batch', 'The exact flow one time at a time and over arrays'),
 }
 
 
