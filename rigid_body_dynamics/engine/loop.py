@@ -10,7 +10,10 @@ its items (``publish(item)``: a Snapshot or ImuSample), its notes
 at most ``publish_budget`` s of it between two integration passes, so that
 with many bodies the steps stay on time while the last bodies' messages lag
 by a few ms (a backlog beyond three items per member is published at once).
-No ROS here: the callables are the nodes'; tests drive it on a fake clock.
+A cycle looks only at the members whose next step is due (a heap of due
+times) or whose schedule moved (``Pace.anchor`` tells the Loop: reset, resume,
+a new rate). No ROS here: the callables are the nodes'; tests drive it on a
+fake clock.
 """
 
 import collections
@@ -23,8 +26,9 @@ import time
 #: Longest sleep of one cycle (s), so that diagnostics and stopping stay prompt.
 LONGEST_WAIT = 0.05
 #: attitude_fleet's budget (s) of publishing between integration passes: one body's tick
-#: (7 messages) takes about 0.5 ms to publish, a step 10-30 us to integrate, so publishing
-#: every body at one tick in a row would make the last bodies' next steps several ms late.
+#: (7 messages and the imu) takes 0.05-0.15 ms to publish (prepacked; 0.5 ms as message
+#: objects), a step 10-30 us to integrate, so publishing every body at one tick in a row
+#: would make the last bodies' next steps several ms late.
 FLEET_PUBLISH_BUDGET = 0.0005
 
 
