@@ -34,8 +34,8 @@ def measure():
     m0 = tuple(i * w for i, w in zip(moments, (0.3, 1.5, -0.4)))
     flow = BodyShape(moments).flow((0.0, 0.0, 0.0, 1.0), m0)
     scalar = _least(lambda: flow.state(0.37), 3000)
-    lines = ['| evaluation | states per call | us per call | us per state | against one at a time |',
-             '|---|---|---|---|---|',
+    lines = ['| evaluation | states per call | us per call | us per state | '
+             'against one at a time |', '|---|---|---|---|---|',
              f'| one float time | 1 | {scalar:.1f} | {scalar:.1f} | 1.0x |']
     for n in (1, 4, 16, 64, 96, 256, 1024):
         times = 0.01 * np.arange(1, n + 1)

@@ -135,7 +135,8 @@ def measure():
     pubs = {kind: [n.create_publisher(t, kind, STATE_QOS) for n in nodes]
             for kind, t in types.items()}
     lines = ['| message | publishers | subscriber | object + publish (us) | '
-             'pack + publish bytes (us) | pack alone (us) | ratio |', '|---|---|---|---|---|---|---|']
+             'pack + publish bytes (us) | pack alone (us) | ratio |',
+             '|---|---|---|---|---|---|---|']
     try:
         for subscriber in (False, True):
             sink = Process(script(SUBSCRIBER) + ['96']) if subscriber else None

@@ -9,12 +9,11 @@ from geometry_msgs.msg import QuaternionStamped, Vector3Stamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message
+from rigid_body_dynamics.ros import conversions as conv
+from rigid_body_dynamics.ros.prepacked import Prepacked
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu
 from std_msgs.msg import Header
-
-from rigid_body_dynamics.ros import conversions as conv
-from rigid_body_dynamics.ros.prepacked import Prepacked
 
 
 def _stamp(rng):
