@@ -77,6 +77,12 @@ def flood(probe, kind):
     try:
         probe.spin_until(lambda: probe.newest_status('torque command') is not None, 40.0,
                          "the simulator's diagnostics")
+        # the previous run's simulator (same node name) may have had diagnostics in flight when
+        # it stopped: forget everything so far, and read only what this simulator sends now
+        probe.spin_for(1.5)
+        probe.messages['/diagnostics'].clear()
+        probe.spin_until(lambda: probe.newest_status('torque command') is not None, 10.0,
+                         "the simulator's diagnostics")
         flooder = Process(script(FLOODER) + [kind, str(RATE), str(SECONDS)])
 
         def started():
