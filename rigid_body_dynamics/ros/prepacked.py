@@ -31,12 +31,12 @@ def _resolve(msg, path):
 
 
 def _layout(field):
-    """Return (struct, sentinel setter) of a Time, float64 fields or a float64 array."""
+    """Return (struct, sentinel setter, is a Time) of a Time, float64 fields or float64s."""
     if isinstance(field, Time):
         def sentinel(k):
             field.sec, field.nanosec = 0x5A5A0000 + k, 0x3C3C0000 + k
             return (field.sec, field.nanosec)
-        return struct.Struct('<iI'), sentinel
+        return struct.Struct('<iI'), sentinel, True
     if hasattr(field, '__len__') and not hasattr(field, 'get_fields_and_field_types'):
         n = len(field)      # a fixed float64 array (a covariance)
 
@@ -44,7 +44,7 @@ def _layout(field):
             values = [1.0e300 / (7 + k) + j for j in range(n)]
             field[:] = values
             return tuple(values)
-        return struct.Struct(f'<{n}d'), sentinel
+        return struct.Struct(f'<{n}d'), sentinel, False
     names = list(field.get_fields_and_field_types())
     types = set(field.get_fields_and_field_types().values())
     if types != {'double'}:
@@ -55,7 +55,7 @@ def _layout(field):
         for name, value in zip(names, values):
             setattr(field, name, value)
         return tuple(values)
-    return struct.Struct(f'<{len(names)}d'), sentinel
+    return struct.Struct(f'<{len(names)}d'), sentinel, False
 
 
 class Prepacked:
@@ -73,17 +73,17 @@ class Prepacked:
         probe = copy.deepcopy(template)
         self.buffer = bytearray(serialize_message(template))
         layouts = [_layout(_resolve(probe, path)) for path in fields]
-        sentinels = [set_sentinel(k) for k, (_, set_sentinel) in enumerate(layouts)]
+        sentinels = [set_sentinel(k) for k, (_, set_sentinel, _) in enumerate(layouts)]
         marked = serialize_message(probe)
         if len(marked) != len(self.buffer):
             raise ValueError('the message layout depends on the refilled values')
         self._slots = []
-        for path, (fmt, _), values in zip(fields, layouts, sentinels):
+        for path, (fmt, _, is_time), values in zip(fields, layouts, sentinels):
             needle = fmt.pack(*values)
             at = marked.find(needle)
             if at < 0 or marked.find(needle, at + 1) >= 0:
                 raise ValueError(f'cannot locate field {path!r} in the serialised message')
-            self._slots.append((fmt.pack_into, at, fmt.format == '<iI'))
+            self._slots.append((fmt.pack_into, at, is_time))
         self.fields = tuple(fields)
 
     def pack(self, *values):

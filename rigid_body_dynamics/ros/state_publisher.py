@@ -81,8 +81,10 @@ class StatePublisher:
         self._odom = pub(Odometry, 'odom')
         self._odom_bytes = Prepacked(odom, ('header.stamp', 'pose.pose.orientation',
                                             'twist.twist.angular'))
+        # each message is prepacked only for a publisher that exists (two serialisations each)
         self._orientation = pub(QuaternionStamped, 'orientation')
-        self._orientation_bytes = _stamped(QuaternionStamped(), world, 'quaternion')
+        if self._orientation is not None:
+            self._orientation_bytes = _stamped(QuaternionStamped(), world, 'quaternion')
         self._vectors = [(p, kind, _stamped(Vector3Stamped(), frame, 'vector'))
                          for p, kind, frame in (
                              (pub(Vector3Stamped, 'angular_velocity'), 'omega', body),
@@ -90,21 +92,23 @@ class StatePublisher:
                              (pub(Vector3Stamped, 'angular_momentum_body'), 'l_body', body))
                          if p is not None]
         self._torque = pub(WrenchStamped, 'applied_torque')
-        self._torque_bytes = _stamped(WrenchStamped(), body, 'wrench.torque')
+        if self._torque is not None:
+            self._torque_bytes = _stamped(WrenchStamped(), body, 'wrench.torque')
         self._imu = pub(Imu, 'imu') if publish_imu else None
-        imu = Imu()
-        imu.header.frame_id = body
-        imu.linear_acceleration_covariance[0] = -1.0    # not simulated (sensor_msgs/Imu)
-        self._imu_bytes = Prepacked(imu, ('header.stamp', 'orientation', 'angular_velocity',
-                                          'orientation_covariance',
-                                          'angular_velocity_covariance'))
-        self._imu_bias = node.create_publisher(Vector3Stamped, '~/imu_bias', STATE_QOS) \
-            if publish_imu else None
-        self._bias_bytes = _stamped(Vector3Stamped(), body, 'vector')
+        if publish_imu:
+            self._imu_bias = node.create_publisher(Vector3Stamped, '~/imu_bias', STATE_QOS)
+            imu = Imu()
+            imu.header.frame_id = body
+            imu.linear_acceleration_covariance[0] = -1.0    # not simulated (sensor_msgs/Imu)
+            self._imu_bytes = Prepacked(imu, ('header.stamp', 'orientation', 'angular_velocity',
+                                              'orientation_covariance',
+                                              'angular_velocity_covariance'))
+            self._bias_bytes = _stamped(Vector3Stamped(), body, 'vector')
         self._inertia = pub(InertiaStamped, 'inertia', LATCHED_QOS)
         self._clock = node.create_publisher(ClockMsg, '/clock', CLOCK_QOS) \
             if publish_clock else None
-        self._clock_bytes = Prepacked(ClockMsg(), ('clock',))
+        if self._clock is not None:
+            self._clock_bytes = Prepacked(ClockMsg(), ('clock',))
         self._tf = node.create_publisher(TFMessage, '/tf', TF_QOS) \
             if publish_tf and tf_available() else None
         if self._tf is not None:
