@@ -142,25 +142,85 @@ def test_drift_since_the_last_torque():
     assert h['direction drift'] < 1e-14 and h['work'] != 0.0
 
 
-def test_pace_real_time_steps_lateness_and_backlog():
+def test_pace_wakes_at_ticks_counts_lateness_and_drops_a_backlog():
+    """Real time: woken at publish ticks (10 steps here), late wakes counted, backlog dropped."""
     clock = FakeClock()
     body = make_body()
     backlog = []
     pace = Pace(body, 1.0, clock=clock, perf=clock.perf, on_backlog=backlog.append)
     outbox = []
-    assert pace.due(outbox) == pytest.approx(1e-3)              # nothing due yet
+    assert pace.due(outbox) == pytest.approx(10e-3)             # the first tick: step 10
     clock.advance(10 * MS)
     wait = pace.due(outbox)
-    assert body.steps == 10 and len(outbox) == 1 and wait == pytest.approx(1e-3)
-    assert pace.missed == 1                                       # the oldest was 9 ms late
+    assert body.steps == 10 and len(outbox) == 1 and wait == pytest.approx(10e-3)
+    assert pace.missed == 0 and pace.take_max_late() == 0.0      # on time
+    clock.advance(17 * MS)                                        # the tick at 20 ms: 7 ms late
+    wait = pace.due(outbox)
+    assert body.steps == 27 and [s.steps for s in outbox] == [10, 20]
+    assert wait == pytest.approx(3e-3) and pace.missed == 1
+    assert pace.take_max_late() == pytest.approx(7.0)
     clock.advance(int(0.3e9))                                     # 300 ms behind: dropped
     pace.due(outbox)
-    assert backlog == [300] and body.steps == 11
+    assert backlog == [300] and body.steps == 28
     pace.set_rtf(2.0)
     clock.advance(10 * MS)
     pace.due(outbox)
-    assert body.steps == 31                                        # 2x: 20 steps in 10 ms
-    assert pace.achieved() > 0.0 and pace.take_max_late() > 0.0
+    assert body.steps == 48                                        # 2x: 20 steps in 10 ms
+    assert pace.achieved() > 0.0
+    body.configure(publish_every=1000)
+    clock.advance(10 * MS)
+    pace.due(outbox)
+    assert pace.due(outbox) == pytest.approx(pacer.COMMAND_LOOK, abs=1e-3)  # at least every 10 ms
+
+
+def test_commands_act_from_the_step_they_came_in_as_if_stepped_every_deadline():
+    """
+    Woken only at ticks, a body ends bit for bit where stepping at every deadline ends.
+
+    Commands (some non-finite, a gap longer than the 50 ms watchdog) come at random
+    steady times. The reference takes the pending ones before each step at its deadline and
+    steps; the paced body is woken at its ticks (with jitter) and gets them with their
+    receive times. Same steps, same torques at the same steps, same counts, same snapshots.
+    """
+    rng = np.random.default_rng(3)
+    clock = FakeClock()
+    t0 = clock.ns
+    times = np.sort(rng.uniform(0.0, 0.4e9, 60)).astype(np.int64) + t0
+    times[40:] += int(0.2e9)                                          # a gap: the watchdog acts
+    vectors = rng.normal(scale=0.2, size=(60, 3))
+    vectors[[7, 33]] = np.nan
+    options = {'publish_every': 10, 'torque_timeout': 0.05}
+    paced, ref = make_body(**options), make_body(**options)
+    pending = list(zip(times.tolist(), vectors))
+
+    def take():
+        came = [p for p in pending if p[0] <= clock.ns]
+        del pending[:len(came)]
+        if not came:
+            return None
+
+        def apply(start, stop, at_ns):
+            for _t, v in came[start:stop]:
+                paced.command(v, False, at_ns)
+        return [c[0] for c in came], apply
+    pace = Pace(paced, 1.0, clock=clock, perf=clock.perf, take_commands=take)
+    out, ref_out = [], []
+    while clock.ns < t0 + int(0.7e9):
+        wait = pace.due(out)
+        clock.advance(wait * 1e9 + rng.uniform(0, 0.4 * MS))
+    k = 0
+    with ref.lock:
+        for step in range(1, paced.steps + 1):
+            at = pace.anchor_ns + step * MS
+            while k < 60 and times[k] <= at:
+                ref.command(vectors[k], False, int(times[k]))
+                k += 1
+            ref.advance(at, ref_out)
+    assert paced.steps > 650 and paced.stepper.q == ref.stepper.q
+    assert paced.stepper.omega == ref.stepper.omega and paced.counts == ref.counts
+    assert [s[:5] for s in out] == [s[:5] for s in ref_out]     # stamp, steps, q, omega, torque
+    assert paced.counts['rejected_non_finite'] == 2
+    assert any(s.torque == (0.0, 0.0, 0.0) for s in out[45:])         # the watchdog did act
 
 
 def test_pace_as_fast_as_possible_and_paused():
@@ -307,7 +367,7 @@ def test_loop_looks_only_at_due_members_and_at_once_at_a_moved_schedule():
     from rigid_body_dynamics.engine import Loop, Member
     from rigid_body_dynamics.engine.pacer import PAUSED_WAIT
     clock = FakeClock()
-    bodies = [make_body(publish_every=1000) for _ in range(2)]
+    bodies = [make_body(publish_every=1) for _ in range(2)]     # a tick every step
     paces = [Pace(b, 1.0, clock=clock, perf=clock.perf) for b in bodies]
     calls = [0, 0]
 

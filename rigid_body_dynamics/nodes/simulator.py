@@ -56,9 +56,10 @@ from ..ros.state_publisher import StatePublisher, tf_available
 from ..ros.throttle import ThrottledWarnings
 
 NODE_NAME = 'attitude_simulator'
-#: torque_cmd: reliable, depth 100, so that a burst between two steps (taken at every step)
-#: is counted whole; the state uses the newest command (latest wins).
-TORQUE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+#: torque_cmd: reliable, depth 1000, so that every command between two wakes of the body
+#: (at most COMMAND_LOOK = 10 ms apart: 100 at 10 kHz) is counted whole, with room for a
+#: stall; the state uses the newest command at each step's deadline.
+TORQUE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
                         reliability=ReliabilityPolicy.RELIABLE)
 #: Period of /diagnostics (s, steady clock).
 DIAGNOSTIC_PERIOD = 1.0
@@ -142,7 +143,7 @@ class AttitudeSimulator(Node):
                                  wait_for_commands=self._take_torque)
         else:
             self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog,
-                             take_commands=lambda: self._take_torque(None))
+                             take_commands=self._arrivals)
         self._report = SimulatorReport(self.body, self.pace, self.lockstep)
         self._make_interfaces()
         self.state.publish_inertia(self.body.inertia, start_ns)
@@ -217,7 +218,9 @@ class AttitudeSimulator(Node):
         self.create_service(SetBool, '~/pause', self._on_pause)
 
     # ------------------------------------------------------------------ torque
-    def _on_torque(self, msg):
+    def _on_torque(self, msg, now_ns=None):
+        """Check, count and hold one command (``now_ns``: its steady arrival time; now)."""
+        now_ns = time.monotonic_ns() if now_ns is None else now_ns
         warn = self._warnings.warn
         frame = msg.header.frame_id
         if not conv.is_finite_vector(msg.wrench.torque):
@@ -233,14 +236,13 @@ class AttitudeSimulator(Node):
         vector, world = conv.vector_array(msg.wrench.torque), \
             frame == world_frame and frame != body_frame
         if self.lockstep:
-            events = self.pace.command(vector, world, time.monotonic_ns(),
-                                       conv.time_ns(msg.header.stamp), force=(f.x, f.y, f.z))
+            events = self.pace.command(vector, world, now_ns, conv.time_ns(msg.header.stamp),
+                                       force=(f.x, f.y, f.z))
             if 'stale' in events:
                 warn('stale', 'lockstep: torque_cmd stamped before the current tick dropped '
                      '(an answer that came after its tick was missed)')
         else:
-            events = self.body.command(vector, world, time.monotonic_ns(),
-                                       force=(f.x, f.y, f.z))
+            events = self.body.command(vector, world, now_ns, force=(f.x, f.y, f.z))
         self._warn_events(events)
 
     def _warn_frame(self, frame):
@@ -261,22 +263,42 @@ class AttitudeSimulator(Node):
                  'does not translate)', period=math.inf)
 
     def _take_torque(self, timeout):
-        """Take every pending torque_cmd (lockstep: waiting up to ``timeout`` s for one)."""
-        if timeout is not None and not self._intake.wait('torque_cmd', timeout):
+        """Lockstep: take every pending torque_cmd, waiting up to ``timeout`` s for one."""
+        if not self._intake.wait('torque_cmd', timeout):
             return
-        raws = self._intake.take('torque_cmd')
-        if not raws:
-            return
-        if not self.lockstep:
-            try:        # one frame, one layout: the whole batch at once (a flood costs little)
-                self._on_torque_batch(*cdr.wrench_arrays(raws, force=True)[1:])
-                return
-            except cdr.NotUniform:
-                pass
-        for raw in raws:
+        for raw in self._intake.take('torque_cmd'):
             self._on_torque(deserialize_message(raw, WrenchStamped))
 
-    def _on_torque_batch(self, torques, frame, forces):
+    def _arrivals(self):
+        """
+        Take every pending torque_cmd for the Pace: (steady receive times, apply) or None.
+
+        The batch is decoded at once when its messages share one frame (a
+        flood costs little), else one by one; ``apply(start, stop, at_ns)``
+        counts and checks commands start:stop as having arrived at ``at_ns``.
+        """
+        stamps = []
+        raws = self._intake.take('torque_cmd', received=stamps)
+        if not raws:
+            return None
+        now = time.monotonic_ns()
+        offset = time.time_ns() - now            # system clock -> steady clock
+        received = [min(r - offset, now) if r else now for r in stamps]
+        try:
+            _, torques, frame, forces = cdr.wrench_arrays(raws, force=True)
+        except cdr.NotUniform:
+            messages = [deserialize_message(raw, WrenchStamped) for raw in raws]
+
+            def apply(start, stop, at_ns):
+                for msg in messages[start:stop]:
+                    self._on_torque(msg, at_ns)
+            return received, apply
+
+        def apply(start, stop, at_ns):
+            self._on_torque_batch(torques[start:stop], frame, forces[start:stop], at_ns)
+        return received, apply
+
+    def _on_torque_batch(self, torques, frame, forces, now_ns):
         """Commands of one frame taken together: counted and checked as _on_torque does."""
         world_frame, body_frame = self._frames
         if frame not in ('', body_frame, world_frame):
@@ -284,7 +306,7 @@ class AttitudeSimulator(Node):
             self._warn_frame(frame)
             return
         events = self.body.command_batch(torques, frame == world_frame and frame != body_frame,
-                                         time.monotonic_ns(), forces)
+                                         now_ns, forces)
         self._warn_events(events)
 
     def destroy_node(self):

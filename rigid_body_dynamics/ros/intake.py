@@ -63,8 +63,13 @@ class Intake:
             waits.wait(max(0, int(timeout * 1e9)))
             return bool(waits.get_ready_entities('subscription'))
 
-    def take(self, topic, limit=100_000):
-        """Return the serialised messages pending on ``topic``, oldest first, at most ``limit``."""
+    def take(self, topic, limit=100_000, received=None):
+        """
+        Return the serialised messages pending on ``topic``, oldest first, at most ``limit``.
+
+        ``received``: a list to which each message's receive time is appended
+        (int ns, system clock, as the middleware stamps it; 0 where it does not).
+        """
         sub = self._subs[topic]
         out = []
         with sub.handle:
@@ -73,6 +78,8 @@ class Intake:
                 if taken is None:
                     break
                 out.append(taken[0])
+                if received is not None:
+                    received.append(taken[1]['received_timestamp'])
         return out
 
     def destroy(self):
