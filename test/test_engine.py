@@ -434,3 +434,11 @@ def test_a_batch_of_commands_counts_and_holds_as_one_by_one():
     nothing = make_body()
     assert nothing.command_batch(np.full((2, 3), np.nan), True, 0) == {'rejected_non_finite'}
     assert nothing.command_held is None
+    # in slices (what a pace does, a slice per step): after each slice, as one by one
+    sliced, ref = make_body(max_torque=0.25), make_body(max_torque=0.25)
+    batch = sliced.batch(vectors, False, forces)
+    for start, stop in ((0, 3), (3, 4), (4, 17), (17, 18), (18, 40)):
+        batch.apply(start, stop, 100 + stop)
+        for v, f in zip(vectors[start:stop], forces[start:stop]):
+            ref.command(v, False, 100 + stop, force=tuple(f))
+        assert sliced.counts == ref.counts and sliced.command_held == ref.command_held

@@ -108,6 +108,68 @@ class Snapshot(NamedTuple):
     odom_only: bool = False    # lockstep's tick state between publish ticks: odom (and clock, TF)
 
 
+class CommandBatch:
+    """
+    Torque commands of one frame taken together, checked at once, applied in slices.
+
+    Made by :meth:`BodySimulation.batch`. ``apply(start, stop, at_ns)`` counts
+    commands ``start:stop`` as :meth:`BodySimulation.command` one after the other
+    would (non-finite refused, components beyond ``max_torque`` clipped, forces
+    ignored) and holds the newest finite one as having arrived at ``at_ns``
+    (steady int ns); it returns the set of events. A pace applies each step's
+    arrivals just before that step, so a flood of N commands costs one check of
+    N vectors and a few integer operations per step.
+    """
+
+    def __init__(self, body, vectors, world, forces):
+        v = np.asarray(vectors, dtype=float).reshape(-1, 3)
+        n = len(v)
+        finite = np.all(np.isfinite(v), axis=1)
+        limit = body.max_torque
+        if limit > 0.0:
+            over = finite & np.any(np.abs(v) > limit, axis=1)
+            v = np.clip(v, -limit, limit)
+        else:
+            over = np.zeros(n, dtype=bool)
+        if forces is not None:
+            f = np.asarray(forces, dtype=float).reshape(-1, 3)
+            pushed = finite & np.any((f != 0.0) | ~np.isfinite(f), axis=1)
+        else:
+            pushed = np.zeros(n, dtype=bool)
+        self.body, self.world, self.size = body, bool(world), n
+        self._vectors = v.tolist()
+        # counts of commands before index i, and the newest finite index at or before i
+        self._bad, self._over, self._pushed = (
+            [0] + np.cumsum(mask).tolist() for mask in (~finite, over, pushed))
+        self._newest = np.maximum.accumulate(np.where(finite, np.arange(n), -1)).tolist()
+
+    def apply(self, start, stop, at_ns):
+        """Count commands start:stop and hold the newest finite one; the set of events."""
+        body, events = self.body, set()
+        with body.lock:
+            counts = body.counts
+            bad = self._bad[stop] - self._bad[start]
+            if bad:
+                counts['rejected_non_finite'] += bad
+                events.add('rejected_non_finite')
+            good = stop - start - bad
+            if not good:
+                return events
+            over = self._over[stop] - self._over[start]
+            if over:
+                counts['clipped'] += over
+                events.add('clipped')
+            pushed = self._pushed[stop] - self._pushed[start]
+            if pushed:
+                counts['force_ignored'] += pushed
+                events.add('force_ignored')
+            counts['accepted'] += good
+            events.add('accepted')
+            body.command_held = body._make_command(tuple(self._vectors[self._newest[stop - 1]]),
+                                                   self.world, int(at_ns))
+        return events
+
+
 class BodySimulation:
     """
     The state of one simulated body and the rules for changing it.
@@ -289,36 +351,13 @@ class BodySimulation:
         beyond ``max_torque`` clipped, forces ignored); the last finite one is
         held. Returns the set of events that happened.
         """
-        vectors = np.asarray(vectors, dtype=float).reshape(-1, 3)
-        finite = np.all(np.isfinite(vectors), axis=1)
-        events = set()
+        batch = self.batch(vectors, world, forces)
+        return batch.apply(0, batch.size, now_ns)
+
+    def batch(self, vectors, world, forces=None):
+        """A :class:`CommandBatch` of these commands, checked at once, to apply in slices."""
         with self.lock:
-            bad = int(np.count_nonzero(~finite))
-            if bad:
-                self.counts['rejected_non_finite'] += bad
-                events.add('rejected_non_finite')
-            good = vectors[finite]
-            if not len(good):
-                return events
-            limit = self.max_torque
-            if limit > 0.0:
-                over = int(np.count_nonzero(np.any(np.abs(good) > limit, axis=1)))
-                if over:
-                    self.counts['clipped'] += over
-                    events.add('clipped')
-            if forces is not None:
-                f = np.asarray(forces, dtype=float).reshape(-1, 3)[finite]
-                pushed = int(np.count_nonzero(np.any((f != 0.0) | ~np.isfinite(f), axis=1)))
-                if pushed:
-                    self.counts['force_ignored'] += pushed
-                    events.add('force_ignored')
-            self.counts['accepted'] += len(good)
-            events.add('accepted')
-            last = tuple(float(c) for c in good[-1])
-            if limit > 0.0:
-                last = tuple(min(max(c, -limit), limit) for c in last)
-            self.command_held = self._make_command(last, bool(world), int(now_ns))
-        return events
+            return CommandBatch(self, vectors, world, forces)
 
     def reject(self, reason, count=1):
         """Count ``count`` commands refused before they got here (e.g. 'rejected_frame')."""

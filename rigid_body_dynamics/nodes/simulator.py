@@ -293,21 +293,18 @@ class AttitudeSimulator(Node):
                 for msg in messages[start:stop]:
                     self._on_torque(msg, at_ns)
             return received, apply
+        return received, self._batch_applier(torques, frame, forces)
 
-        def apply(start, stop, at_ns):
-            self._on_torque_batch(torques[start:stop], frame, forces[start:stop], at_ns)
-        return received, apply
-
-    def _on_torque_batch(self, torques, frame, forces, now_ns):
-        """Commands of one frame taken together: counted and checked as _on_torque does."""
+    def _batch_applier(self, torques, frame, forces):
+        """apply(start, stop, at_ns) for commands of one frame: checked as _on_torque does."""
         world_frame, body_frame = self._frames
         if frame not in ('', body_frame, world_frame):
-            self.body.reject('rejected_frame', len(torques))
-            self._warn_frame(frame)
-            return
-        events = self.body.command_batch(torques, frame == world_frame and frame != body_frame,
-                                         now_ns, forces)
-        self._warn_events(events)
+            def refuse(start, stop, _at_ns):
+                self.body.reject('rejected_frame', stop - start)
+                self._warn_frame(frame)
+            return refuse
+        batch = self.body.batch(torques, frame == world_frame and frame != body_frame, forces)
+        return lambda start, stop, at_ns: self._warn_events(batch.apply(start, stop, at_ns))
 
     def destroy_node(self):
         """Destroy the torque intake's helper node too."""
