@@ -8,8 +8,12 @@ rate actually sent, the commands the simulator took (accepted + rejected
 counters in its diagnostics), its achieved real-time factor and missed
 deadlines, odom received by a subscriber, the simulator's CPU; for the
 rejected classes also the largest deviation of the published state from the
-exact free motion (the run that never saw the flood). ``./dev bench --only
-flood`` (about 2 minutes).
+exact free motion (the run that never saw the flood). The floor: the same
+valid flood into a bare rclpy process that only takes every pending message
+(serialised, with its receive time, as the simulator does) every 10 ms and
+counts them, with the simulator's QoS: what receiving the flood costs any
+Python node that sees every command. ``./dev bench --only flood`` (about 2
+minutes).
 """
 
 import os
@@ -62,6 +66,29 @@ FLOODER = textwrap.dedent("""
     print('sent', sent, time.perf_counter() - start, flush=True)
     node.destroy_node()
     rclpy.shutdown()
+""")
+FLOOR = textwrap.dedent("""
+    import signal, sys, threading
+    import rclpy
+    from geometry_msgs.msg import WrenchStamped
+    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+    rclpy.init()
+    node = rclpy.create_node('attitude_simulator')
+    qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
+                     reliability=ReliabilityPolicy.RELIABLE)
+    sub = node.create_subscription(WrenchStamped, 'torque_cmd', lambda _m: None, qos, raw=True)
+    stop = threading.Event()
+    signal.signal(signal.SIGINT, lambda *_: stop.set())
+    taken = 0
+    while not stop.wait(0.01):
+        with sub.handle:
+            while True:
+                got = sub.handle.take_message(sub.msg_type, True)
+                if got is None:
+                    break
+                got[1]['received_timestamp']
+                taken += 1
+    print('taken', taken, flush=True)
 """)
 KINDS = ('valid body torque', 'non-finite torque', 'unknown frame_id')
 COUNTERS = ('accepted', 'rejected_non_finite', 'rejected_frame')
@@ -119,6 +146,34 @@ def flood(probe, kind):
             alive)
 
 
+def floor(probe):
+    """The valid flood into the bare taking process; returns (CPU fraction, fraction taken)."""
+    taker = Process(script(FLOOR))
+    flooder = None
+    try:
+        probe.spin_for(3.0)
+        flooder = Process(script(FLOODER) + [KINDS[0], str(RATE), str(SECONDS)])
+
+        def started():
+            flooder.log.seek(0)
+            return b'start' in flooder.log.read()
+        probe.spin_until(started, 40.0, 'the flooder')
+        c0, t0 = cpu_seconds(taker.proc.pid), time.monotonic()
+        probe.spin_until(lambda: flooder.proc.poll() is not None, SECONDS + 30.0, 'the flood')
+        cpu = (cpu_seconds(taker.proc.pid) - c0) / (time.monotonic() - t0)
+        probe.spin_for(0.5)
+    finally:
+        if flooder is not None:
+            flooder.close()
+        taker.close()
+    flooder.log.seek(0)
+    sent = int([ln for ln in flooder.log.read().decode().splitlines()
+                if ln.startswith('sent')][-1].split()[1])
+    taker.log.seek(0)
+    took = [ln for ln in taker.log.read().decode().splitlines() if ln.startswith('taken')]
+    return cpu, (int(took[-1].split()[1]) / sent if took else float('nan'))
+
+
 def measure():
     """All flood classes; returns Markdown lines."""
     probe = Probe('bench_flood')
@@ -135,8 +190,13 @@ def measure():
             lines.append(f'| {r[0]} | {r[1]:.0f} | {r[2]} | {r[3]:.2f} | {r[4]} | {r[5]:.3f} | '
                          f'{r[6]:.0f} | {100 * r[7]:.0f} | {error} | {"yes" if r[9] else "no"} |')
             print(lines[-1], flush=True)
+        cpu, taken = floor(probe)
+        lines.append(f'| floor: bare rclpy process taking the valid flood every 10 ms | | | '
+                     f'{taken:.2f} | | | | {100 * cpu:.0f} | | |')
+        print(lines[-1], flush=True)
     finally:
         probe.close()
-    return lines + ['', 'The simulator takes every pending command at each step (a subscriber '
-                    'queue of 100, one batch decoded at once) and uses the newest; every '
-                    'command taken is counted as accepted or rejected.']
+    return lines + ['', 'The simulator wakes at its ticks (here every 10 ms), takes every '
+                    'pending command with its receive time (a subscriber queue of 1000, one '
+                    'batch decoded and checked at once) and applies each from the step during '
+                    'which it came; every command taken is counted as accepted or rejected.']

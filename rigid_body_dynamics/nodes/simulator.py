@@ -9,11 +9,13 @@ services and the diagnostics; the body is an engine
 an engine :class:`~rigid_body_dynamics.engine.pacer.Pace`, and its state
 messages come from a :class:`~.state_publisher.StatePublisher`.
 
-Threads. Integration and state publishing run on one steady-clock thread
-that sleeps until each step's deadline, so a torque command is used from the
-next integration step on and pacing costs a few percent of a core at 1 kHz.
-Subscriptions, services, parameter changes and diagnostics run on the
-executor; both sides share the body under its lock.
+Threads. Integration and state publishing run on one steady-clock thread,
+woken at the body's ticks (a step that publishes, and at least every 10 ms):
+it takes the torque commands that came, with their receive times, and
+integrates the due steps, each with the command newest at its deadline (see
+:class:`~rigid_body_dynamics.engine.pacer.Pace`). Services, parameter changes
+and diagnostics run on the executor; both sides share the body under its
+lock.
 
 Time. The simulated time is an integer step count times dt. Every message of
 one publish tick carries header.stamp = start + simulated time (start is the
