@@ -147,7 +147,7 @@ def flood(probe, kind):
 
 
 def floor(probe):
-    """The valid flood into the bare taking process; returns (CPU fraction, fraction taken)."""
+    """Flood the bare taking process with valid commands; (CPU fraction, fraction taken)."""
     taker = Process(script(FLOOR))
     flooder = None
     try:

@@ -355,7 +355,7 @@ class BodySimulation:
         return batch.apply(0, batch.size, now_ns)
 
     def batch(self, vectors, world, forces=None):
-        """A :class:`CommandBatch` of these commands, checked at once, to apply in slices."""
+        """Check these commands at once: a :class:`CommandBatch` to apply in slices."""
         with self.lock:
             return CommandBatch(self, vectors, world, forces)
 
