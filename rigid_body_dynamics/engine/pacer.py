@@ -183,7 +183,7 @@ class Pace:
             taken[1](0, len(taken[0]), now)
 
     def _next_target(self):
-        """The step the next wake is for: the next that publishes, or COMMAND_LOOK s ahead."""
+        """Return the step the next wake is for: the next that publishes, or COMMAND_LOOK s on."""
         body = self.body
         steps = body.steps
         ahead = body.publish_every - steps % body.publish_every
