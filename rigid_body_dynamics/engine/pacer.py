@@ -129,7 +129,7 @@ class Pace:
             if body.paused:
                 return PAUSED_WAIT
             if self.rtf == 0.0:
-                self._apply_all(self.clock())
+                self._apply_all()
                 end = self.perf() + AFAP_BATCH
                 while self.perf() < end:
                     body.advance(self.clock(), outbox)
@@ -150,7 +150,7 @@ class Pace:
                         due_steps = body.steps + 1
                 self._steps_to(due_steps, outbox, now)
             else:
-                self._apply_all(now)
+                self._apply_all()
             return max(0.0, (self.deadline(self._next_target()) - self.clock()) / _NS)
 
     def deadline(self, step):
@@ -176,11 +176,12 @@ class Pace:
         if i < n:
             apply(i, n, received[n - 1])
 
-    def _apply_all(self, now):
-        """Hand every pending command to the body now (no steps due, or as fast as possible)."""
+    def _apply_all(self):
+        """Hand every pending command to the body at once (no steps due, or as fast as possible)."""
         taken = self.take_commands() if self.take_commands is not None else None
         if taken is not None and len(taken[0]):
-            taken[1](0, len(taken[0]), now)
+            received, apply = taken
+            apply(0, len(received), received[-1])
 
     def _next_target(self):
         """Return the step the next wake is for: the next that publishes, or COMMAND_LOOK s on."""
