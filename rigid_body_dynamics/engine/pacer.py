@@ -148,7 +148,7 @@ class Pace:
                         self.on_backlog(due_steps - body.steps)
                         self.anchor()
                         due_steps = body.steps + 1
-                self._steps_to(due_steps, outbox, now)
+                self._steps_to(due_steps, outbox)
             else:
                 self._apply_all()
             return max(0.0, (self.deadline(self._next_target()) - self.clock()) / _NS)
@@ -158,7 +158,7 @@ class Pace:
         period = self.body.dt_ns / self.rtf
         return self.anchor_ns + int((step - self.anchor_steps) * period)
 
-    def _steps_to(self, due_steps, outbox, now):
+    def _steps_to(self, due_steps, outbox):
         """Integrate up to step ``due_steps``, each with the command newest at its deadline."""
         body = self.body
         taken = self.take_commands() if self.take_commands is not None else None
