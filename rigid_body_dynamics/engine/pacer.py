@@ -177,7 +177,7 @@ class Pace:
             apply(i, n, received[n - 1])
 
     def _apply_all(self):
-        """Hand every pending command to the body at once (no steps due, or as fast as possible)."""
+        """Hand every pending command to the body at once (no step due, or as fast as possible)."""
         taken = self.take_commands() if self.take_commands is not None else None
         if taken is not None and len(taken[0]):
             received, apply = taken
