@@ -164,8 +164,10 @@ class Pace:
         taken = self.take_commands() if self.take_commands is not None else None
         received, apply = taken if taken is not None else ((), None)
         i, n = 0, len(received)
+        # (self.deadline(step), inlined: this loop runs at every step of every body)
+        anchor_ns, anchor_steps, period = self.anchor_ns, self.anchor_steps, body.dt_ns / self.rtf
         for step in range(body.steps + 1, due_steps + 1):
-            at = self.deadline(step)
+            at = anchor_ns + int((step - anchor_steps) * period)
             if i < n and received[i] <= at:
                 j = i + 1
                 while j < n and received[j] <= at:
