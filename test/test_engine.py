@@ -350,9 +350,18 @@ def test_loop_publishes_within_its_budget_and_schedules_diagnostics():
     loop.cycle()
     assert published == [(0, 1 * MS), (0, 2 * MS), (0, 3 * MS),
                          (1, 1 * MS), (1, 2 * MS), (1, 3 * MS)]
-    seconds[0] = 1.5
+    seconds[0] = 0.5                 # diagnostics spread over the period: one member by now
+    loop.cycle()
+    assert diagnosed == [0]
+    seconds[0] = 1.0
     loop.cycle()
     assert diagnosed == [0, 1]
+    seconds[0] = 3.2                 # after a stall: each member once, not every missed turn
+    loop.cycle()
+    assert diagnosed == [0, 1, 0, 1]
+    seconds[0] = 3.5
+    loop.cycle()
+    assert diagnosed == [0, 1, 0, 1, 0]
     assert 0.0 < loop.cycle() <= 0.05                    # sleeps until the next step, capped
 
 

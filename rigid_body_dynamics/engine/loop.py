@@ -6,7 +6,8 @@ N on a shared thread. Each :class:`Member` is a pace (a
 :class:`~.pacer.Pace` or :class:`~.lockstep.Lockstep`) with what to do with
 its items (``publish(item)``: a Snapshot or ImuSample), its notes
 (``log_notes()``) and, optionally, its diagnostics (``diagnostics()``, every
-``diagnostics_period`` s on this thread). Publishing goes through a queue:
+``diagnostics_period`` s on this thread, the members' spread evenly over the
+period). Publishing goes through a queue:
 at most ``publish_budget`` s of it between two integration passes, so that
 with many bodies the steps stay on time while the last bodies' messages lag
 by a few ms (a backlog beyond three items per member is published at once).
@@ -62,15 +63,30 @@ class Loop:
         self._moved = collections.deque()
         for k, member in enumerate(self.members):
             member.pace.on_anchor = functools.partial(self._moved.append, k)
-        self._next_diagnostics = clock() + self.period if self.period else math.inf
+        # diagnostics one member at a time, spread evenly over the period: all of a fleet's at
+        # once (0.5 ms each here) queued 20-50 ms of publishing at every period, the queue
+        # overflowed its backlog limit and was published in one go, and every body's next
+        # step came that late (seen as late steps once a second in fleets of 48-96)
+        self._reporting = [m for m in self.members if m.diagnostics is not None]
+        self._spacing = self.period / max(len(self._reporting), 1)
+        self._next_diagnostics = clock() + self._spacing \
+            if self.period and self._reporting else math.inf
+        self._report_index = 0
 
     def cycle(self):
         """Integrate every member's due steps, publish within the budget; the wait (s)."""
         pending, outbox = self.pending, self._outbox
         now = self.clock()
         if now >= self._next_diagnostics:
-            self._next_diagnostics = max(self._next_diagnostics + self.period, now)
-            pending.extend((m, None) for m in self.members if m.diagnostics is not None)
+            reporting = self._reporting
+            # the members due by now (at most all of them, once, after a long stall)
+            due_reports = min(int((now - self._next_diagnostics) / self._spacing) + 1,
+                              len(reporting))
+            for _ in range(due_reports):
+                pending.append((reporting[self._report_index], None))
+                self._report_index = (self._report_index + 1) % len(reporting)
+            self._next_diagnostics = max(self._next_diagnostics + due_reports * self._spacing,
+                                         now)
         due, members, looked, upcoming = self._due, self.members, [], self._next
         moved = self._moved
         while moved:                       # (appended by other threads: popped one by one)
