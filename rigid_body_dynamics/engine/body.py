@@ -415,6 +415,43 @@ class BodySimulation:
         if self.imu_every and self.steps % self.imu_every == 0:
             outbox.append(self.imu_sample())
 
+    def advance_free(self, count, now_ns, outbox):
+        """
+        Advance ``count`` steps at once if no torque acts on them (call under ``lock``).
+
+        Returns False, and does nothing, unless the steps are torque-free
+        whatever their time: no disturbance, and no command or one the
+        watchdog has already dropped at ``now_ns`` (the first step's time). Then
+        the integrator counts them in one go (the exact flow evaluates nothing
+        until read) and the ticks among them go to ``outbox``: the same state
+        and items as ``count`` calls of :meth:`advance`.
+        """
+        if self._dist_body is not None or self._dist_world is not None or \
+                self._field is not None:
+            return False
+        if self.command_held is not None:
+            self.torque_now(now_ns)            # the watchdog, as the first step would ask it
+            if not self.timed_out:
+                return False
+        if self._base_stale:
+            self._baseline()                   # the state after the last step under torque
+        self._held = (_ZERO, None, None)
+        publish, imu = self.publish_every, self.imu_every
+        while count > 0:
+            steps = self.steps
+            run = publish - steps % publish
+            if imu:
+                run = min(run, imu - steps % imu)
+            run = min(run, count)
+            self.stepper.free_steps(run)
+            self.steps += run
+            count -= run
+            if self.steps % publish == 0:
+                outbox.append(self.snapshot())
+            if imu and self.steps % imu == 0:
+                outbox.append(self.imu_sample())
+        return True
+
     def first_items(self):
         """Return the items of time 0 (call under ``lock``): the state, and an IMU sample."""
         items = [self.snapshot()]

@@ -174,6 +174,9 @@ class Pace:
                     j += 1
                 apply(i, j, received[j - 1])
                 i = j
+            if i == n and due_steps > step and body.advance_free(due_steps - step + 1, at,
+                                                                  outbox):
+                break        # the rest torque-free and no command to come in between: at once
             body.advance(at, outbox)
         if i < n:
             apply(i, n, received[n - 1])

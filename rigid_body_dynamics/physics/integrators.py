@@ -188,6 +188,11 @@ class Integrator(ABC):
                              for acc, a, b in zip(self._impulse, after, before)]
         self.steps += 1
 
+    def free_steps(self, count):
+        """Advance by ``count`` torque-free steps: the same state as ``count`` calls of step()."""
+        for _ in range(count):
+            self.step()
+
     @abstractmethod
     def _free_step(self):
         """Advance self.q, self.omega by dt without torque (the step is counted by step())."""
@@ -285,6 +290,22 @@ class ExactIntegrator(Integrator):
         # omega is read (a snapshot, a torque step, diagnostics), not at every step. The
         # same closed form at the same time, so the same numbers, bit for bit.
         self._lazy = True
+
+    def free_steps(self, count):
+        """
+        Advance by ``count`` torque-free steps; on the closed-form flow, one count.
+
+        The state after them is the flow's at the step count, read when q or
+        omega is read: bit for bit what ``count`` calls of step() give.
+        """
+        if count <= 0:
+            return
+        self.step()
+        if self._lazy:              # a closed-form segment (not RK near the separatrix)
+            self.steps += count - 1
+        else:
+            for _ in range(count - 1):
+                self.step()
 
     # q and omega: plain attributes in the other integrators; here read through the flow
     @property
