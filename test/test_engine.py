@@ -426,20 +426,28 @@ def test_loop_looks_only_at_due_members_and_at_once_at_a_moved_schedule():
 
 
 def test_paces_anchor_on_whole_periods_and_spread_over_phases():
-    """Steps fall on whole periods of the clock plus the phase; 40 bodies: 3 phases."""
+    """
+    Steps on whole periods of the clock plus the phase; 40 bodies: 3 phases of the wake period.
+
+    1 kHz steps, a tick every 10: the groups' phases are 0, 10/3 and 20/3 steps, so their
+    ticks (wakes) fall 3.3 ms apart, not their steps alone.
+    """
     from rigid_body_dynamics.engine.pacer import spread_phases
     clock = FakeClock()
     clock.advance(0.3 * MS)                       # between two whole periods of 1 ms
     paces = [Pace(make_body(), 1.0, clock=clock, perf=clock.perf) for _ in range(40)]
-    assert {p.anchor_ns % MS for p in paces} == {0}
+    assert {p.anchor_ns % MS for p in paces} == {0} and paces[0].wake_steps == 10
     spread_phases(paces)
-    assert sorted({p.phase for p in paces}) == pytest.approx([0.0, 1 / 3, 2 / 3])
+    assert sorted({p.phase for p in paces}) == pytest.approx([0.0, 10 / 3, 20 / 3])
     assert sum(p.phase == 0.0 for p in paces) == 14      # at most 16 due at one instant
+    ticks = set()
     for p in paces:
         assert (p.anchor_ns - p.phase * MS) % MS == pytest.approx(0.0, abs=1e-3)
-        assert 0 <= clock.ns - p.anchor_ns < MS            # the first step within a period
+        assert 0 <= clock.ns - (p.anchor_ns - p.phase * MS) < MS  # first step: 1 + phase
+        ticks.add(round((p.deadline(10) - paces[0].deadline(10)) / MS, 3))
+    assert ticks == {0.0, 3.333, 6.667}                    # the groups' ticks 3.3 ms apart
     with pytest.raises(ValueError, match='phase'):
-        paces[0].set_phase(1.0)
+        paces[0].set_phase(-0.5)
 
 
 def test_a_batch_of_commands_counts_and_holds_as_one_by_one():

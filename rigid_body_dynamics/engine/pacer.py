@@ -18,6 +18,7 @@ the motion is the one that stepping at every deadline gives, at a tenth of
 the wake-ups for the defaults (1 kHz steps, 100 Hz publishing).
 """
 
+import math
 import time
 
 _NS = 1_000_000_000
@@ -87,23 +88,36 @@ class Pace:
         them all: a wake-up per body and step cost a fleet of 96 bodies more
         than their steps, and all 96 at one instant made the last ones late
         (attitude_fleet spreads its bodies over a few phases). The first step
-        comes at most one period after this call.
+        comes at most 1 + ``phase`` periods after this call.
         """
         now = self.clock()
         period = self.body.dt_ns / self.rtf if self.rtf > 0.0 else self.body.dt_ns
-        offset = self.phase * period
-        self.anchor_ns = now - (now - offset) % period
+        # the last whole period of the clock, then the phase (the first step may be later)
+        self.anchor_ns = now - now % period + self.phase * period
         self.anchor_steps = self.body.steps
         self._target = 0
         if self.on_anchor is not None:
             self.on_anchor()             # tell the Loop: the next step may be earlier now
 
     def set_phase(self, phase):
-        """Shift the step instants by ``phase`` periods (0 <= phase < 1; re-anchors)."""
-        if not 0.0 <= phase < 1.0:
-            raise ValueError(f'phase must be in [0, 1), got {phase!r}')
+        """
+        Shift the step instants by ``phase`` step periods (>= 0; re-anchors).
+
+        The fraction moves the steps off the whole periods of the clock; the
+        whole part delays the next step by that many periods, which moves the
+        body's ticks (its wakes) against those of bodies with another phase.
+        """
+        if not 0.0 <= phase < math.inf:
+            raise ValueError(f'phase must be a number >= 0, got {phase!r}')
         self.phase = float(phase)
         self.anchor()
+
+    @property
+    def wake_steps(self):
+        """Steps from one wake to the next in real time: to the next tick, or COMMAND_LOOK."""
+        body = self.body
+        look = max(1, int(COMMAND_LOOK * _NS * self.rtf / body.dt_ns)) if self.rtf else 1
+        return min(body.publish_every, body.imu_every or body.publish_every, look)
 
     def restart(self):
         """After a reset of the body: a new anchor and no lateness counted so far."""
@@ -216,12 +230,14 @@ class Pace:
 
 def spread_phases(paces, per_phase=PHASE_BODIES):
     """
-    Spread ``paces`` over ceil(N / per_phase) equally spaced phases of their step period.
+    Spread ``paces`` over ceil(N / per_phase) equally spaced phases of their wake period.
 
-    So that one thread's N bodies are due in groups of at most ``per_phase``: one
-    wake-up per group and step, not per body, and no burst of all N at once.
+    So that one thread's N bodies wake in groups of at most ``per_phase``: one
+    wake-up per group and tick, not per body, and no burst of all N at once.
+    The wake period is :attr:`Pace.wake_steps` step periods (10 at 1 kHz steps
+    and 100 Hz publishing), so the groups' ticks fall apart, not just their steps.
     """
     paces = list(paces)
     phases = max(1, -(-len(paces) // per_phase))
     for k, pace in enumerate(paces):
-        pace.set_phase((k % phases) / phases)
+        pace.set_phase((k % phases) / phases * pace.wake_steps)
