@@ -114,7 +114,7 @@ class Pace:
 
     @property
     def wake_steps(self):
-        """Steps from one wake to the next in real time: to the next tick, or COMMAND_LOOK."""
+        """Return the steps from one wake to the next in real time: a tick, or COMMAND_LOOK."""
         body = self.body
         look = max(1, int(COMMAND_LOOK * _NS * self.rtf / body.dt_ns)) if self.rtf else 1
         return min(body.publish_every, body.imu_every or body.publish_every, look)
@@ -188,8 +188,8 @@ class Pace:
                     j += 1
                 apply(i, j, received[j - 1])
                 i = j
-            if i == n and due_steps > step and body.advance_free(due_steps - step + 1, at,
-                                                                  outbox):
+            rest = due_steps - step + 1
+            if i == n and rest > 1 and body.advance_free(rest, at, outbox):
                 break        # the rest torque-free and no command to come in between: at once
             body.advance(at, outbox)
         if i < n:
