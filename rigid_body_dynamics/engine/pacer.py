@@ -116,8 +116,11 @@ class Pace:
     def wake_steps(self):
         """Return the steps from one wake to the next in real time: a tick, or COMMAND_LOOK."""
         body = self.body
-        look = max(1, int(COMMAND_LOOK * _NS * self.rtf / body.dt_ns)) if self.rtf else 1
-        return min(body.publish_every, body.imu_every or body.publish_every, look)
+        return min(body.publish_every, body.imu_every or body.publish_every, self._look_steps())
+
+    def _look_steps(self):
+        """Return the steps in COMMAND_LOOK s of wall time (at least 1)."""
+        return max(1, int(COMMAND_LOOK * _NS * self.rtf / self.body.dt_ns)) if self.rtf else 1
 
     def restart(self):
         """After a reset of the body: a new anchor and no lateness counted so far."""
@@ -175,8 +178,7 @@ class Pace:
     def _steps_to(self, due_steps, outbox):
         """Integrate up to step ``due_steps``, each with the command newest at its deadline."""
         body = self.body
-        taken = self.take_commands() if self.take_commands is not None else None
-        received, apply = taken if taken is not None else ((), None)
+        received, apply = self._take()
         i, n = 0, len(received)
         # (self.deadline(step), inlined: this loop runs at every step of every body)
         anchor_ns, anchor_steps, period = self.anchor_ns, self.anchor_steps, body.dt_ns / self.rtf
@@ -197,10 +199,14 @@ class Pace:
 
     def _apply_all(self):
         """Hand every pending command to the body at once (no step due, or as fast as possible)."""
-        taken = self.take_commands() if self.take_commands is not None else None
-        if taken is not None and len(taken[0]):
-            received, apply = taken
+        received, apply = self._take()
+        if received:
             apply(0, len(received), received[-1])
+
+    def _take(self):
+        """Take the pending commands: (steady receive times, apply), or ((), None)."""
+        taken = self.take_commands() if self.take_commands is not None else None
+        return taken if taken is not None else ((), None)
 
     def _next_target(self):
         """Return the step the next wake is for: the next that publishes, or COMMAND_LOOK s on."""
@@ -209,8 +215,7 @@ class Pace:
         ahead = body.publish_every - steps % body.publish_every
         if body.imu_every:
             ahead = min(ahead, body.imu_every - steps % body.imu_every)
-        look = max(1, int(COMMAND_LOOK * _NS * self.rtf / body.dt_ns))
-        self._target = steps + min(ahead, look)
+        self._target = steps + min(ahead, self._look_steps())
         return self._target
 
     def achieved(self):
