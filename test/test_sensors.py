@@ -79,6 +79,33 @@ def test_same_seed_same_stream_bit_for_bit_single_or_in_blocks():
     assert np.array_equal(a, d)
 
 
+@pytest.mark.parametrize('errors', [
+    GyroErrors(),
+    GyroErrors(turn_on_bias=1e-3),
+    GyroErrors(noise_density=1e-3, bias_random_walk=1e-4, turn_on_bias=1e-3),
+    GyroErrors(noise_density=1e-3, bias_random_walk=1e-4, correlation_time=2.0),
+    GyroErrors(noise_density=1e-3, bias_random_walk=1e-4, resolution=1e-3),
+    GyroErrors(noise_density=1e-3, bias_random_walk=1e-4, orientation_noise=0.01),
+], ids=['perfect', 'turn-on bias', 'random walk', 'gauss-markov', 'quantised', 'orientation'])
+def test_read_in_scalars_equals_the_vectorised_model_bit_for_bit(errors):
+    """read() (the simulator's per-tick path, plain floats) draws and computes as sample()."""
+    rng = np.random.default_rng(3)
+    omega = rng.normal(size=(200, 3))
+    q = rng.normal(size=(200, 4))
+    q /= np.linalg.norm(q, axis=1)[:, None]
+    fast, ref = GyroModel(errors, RATE, seed=11), GyroModel(errors, RATE, seed=11)
+    for qk, wk in zip(q, omega):
+        q_read, measured, bias = fast.read(tuple(qk), tuple(wk))
+        m_ref, b_ref = ref.measure(wk)
+        assert measured == tuple(m_ref) and bias == tuple(b_ref)
+        assert q_read == tuple(ref.orientation(qk))
+        assert all(type(c) is float for c in (*q_read, *measured, *bias))
+    assert np.array_equal(fast.bias, ref.bias)
+    if errors.resolution:
+        assert np.allclose(np.asarray(measured) / errors.resolution,
+                           np.round(np.asarray(measured) / errors.resolution), atol=1e-9)
+
+
 def test_orientation_noise_statistics():
     gyro = GyroModel(GyroErrors(orientation_noise=0.01), RATE, seed=9)
     q0 = quaternions.from_axis_angle(np.array([0.0, 0.0, 1.0]), 0.7)

@@ -248,8 +248,10 @@ class BodySimulation:
         return s.kinetic_energy, s.angular_momentum_world
 
     def body_state(self):
-        """(q, omega) of the user's body frame as arrays."""
+        """(q (x, y, z, w), omega (rad/s)) of the user's body frame, as sequences of floats."""
         s, body = self.stepper, self.inertia
+        if body.is_principal_frame:
+            return s.q, s.omega
         return body.attitude_to_body(np.array(s.q)), body.to_body(np.array(s.omega))
 
     def set_paused(self, paused):
@@ -463,9 +465,7 @@ class BodySimulation:
         """Sample the gyro at the current state (call under ``lock``): an :class:`ImuSample`."""
         gyro = self.gyro
         q, measured, bias = gyro.read(*self.body_state())
-        return ImuSample(self.stamp_now(),
-                         tuple(float(c) for c in q),
-                         tuple(float(c) for c in measured), tuple(float(c) for c in bias),
+        return ImuSample(self.stamp_now(), q, measured, bias,
                          gyro.rate_variance, gyro.orientation_variance)
 
     def stamp_now(self):

@@ -152,12 +152,39 @@ class GyroModel:
         """
         Take one IMU reading of the true attitude q (x, y, z, w) and rate omega (3,) rad/s.
 
-        Returns (reported q, measured rate, bias in it), body frame: the rate is
-        drawn first, then the orientation noise, the order the simulator uses,
-        so a stream offline and one over topics are the same.
+        Returns (reported q, measured rate, bias in it) as tuples of floats, body
+        frame: the rate is drawn first, then the orientation noise, the order the
+        simulator uses, so a stream offline and one over topics are the same.
+        The same numbers as :meth:`measure` (tested bit for bit), in scalar
+        arithmetic: the simulator reads its gyro at every IMU tick, and numpy's
+        per-call cost made a reading 29 us (56 us with noise) where this takes
+        a few.
         """
-        measured, bias = self.measure(omega)
-        return self.orientation(q), measured, bias
+        bias = self.bias
+        b = (float(bias[0]), float(bias[1]), float(bias[2]))
+        w = (float(omega[0]), float(omega[1]), float(omega[2]))
+        if self._perfect:
+            rates = (w[0] + b[0], w[1] + b[1], w[2] + b[2])
+        else:
+            # the draws of sample(): white noise, then the bias increment, 3 normals each
+            d = self._rng.standard_normal(6).tolist()
+            white, phi, walk = self._white, self._phi, self._walk
+            rates = (w[0] + b[0] + white * d[0], w[1] + b[1] + white * d[1],
+                     w[2] + b[2] + white * d[2])
+            if phi == 1.0:
+                self.bias = np.array((b[0] + walk * d[3], b[1] + walk * d[4],
+                                      b[2] + walk * d[5]))
+            else:
+                self.bias = np.array((phi * b[0] + walk * d[3], phi * b[1] + walk * d[4],
+                                      phi * b[2] + walk * d[5]))
+        r = self.errors.resolution
+        if r:
+            rates = (round(rates[0] / r) * r, round(rates[1] / r) * r, round(rates[2] / r) * r)
+        if self.errors.orientation_noise:
+            q = tuple(self.orientation(q).tolist())
+        else:
+            q = (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
+        return q, rates, b
 
     def orientation(self, q):
         """Return the attitude q (x, y, z, w) with the orientation noise applied (body frame)."""
