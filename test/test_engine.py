@@ -170,7 +170,33 @@ def test_pace_wakes_at_ticks_counts_lateness_and_drops_a_backlog():
     body.configure(publish_every=1000)
     clock.advance(10 * MS)
     pace.due(outbox)
-    assert pace.due(outbox) == pytest.approx(pacer.COMMAND_LOOK, abs=1e-3)  # at least every 10 ms
+    assert pace.due(outbox) == pytest.approx(pacer.COMMAND_LOOK, abs=1e-3)  # at least every 20 ms
+
+
+def test_achieved_rate_is_counted_wake_to_wake_not_to_the_call():
+    """A body woken every 20 ms (50 Hz ticks) reads 1 in every 1 s period, wherever it is read."""
+    clock = FakeClock()
+    body = make_body(publish_every=20)
+    pace = Pace(body, 1.0, clock=clock, perf=clock.perf)
+    outbox, readings = [], []
+    clock.advance(int(pace.due(outbox) * 1e9))
+    pace.achieved()
+    for offset in (3, 7, 11, 15, 19, 5):         # ms after a wake at which diagnostics read it
+        end = clock.ns + 1000 * MS
+        while True:
+            wait = int(round(pace.due(outbox) * 1e9))
+            if clock.ns + wait > end + offset * MS:
+                break
+            clock.advance(wait)
+        clock.ns = end + offset * MS
+        readings.append(pace.achieved())
+    # each exactly 1 (wake to wake, every wake on time); counted to the call they read
+    # 0.985-1.017 here
+    assert readings == pytest.approx([1.0] * 6, abs=1e-12)
+    assert pace.missed == 0
+    body.set_paused(True)
+    clock.advance(1000 * MS)
+    assert pace.achieved() == 0.0
 
 
 def test_commands_act_from_the_step_they_came_in_as_if_stepped_every_deadline():

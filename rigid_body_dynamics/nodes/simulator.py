@@ -59,7 +59,7 @@ from ..ros.throttle import ThrottledWarnings
 
 NODE_NAME = 'attitude_simulator'
 #: torque_cmd: reliable, depth 1000, so that every command between two wakes of the body
-#: (at most COMMAND_LOOK = 10 ms apart: 100 at 10 kHz) is counted whole, with room for a
+#: (at most COMMAND_LOOK = 20 ms apart: 200 at 10 kHz) is counted whole, with room for a
 #: stall; the state uses the newest command at each step's deadline.
 TORQUE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
                         reliability=ReliabilityPolicy.RELIABLE)
