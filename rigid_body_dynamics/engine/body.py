@@ -310,8 +310,12 @@ class BodySimulation:
 
     # ------------------------------------------------------------------ torque
     def _make_command(self, vector, world, received_ns, stamp_ns=None):
-        principal = None if world else tuple(
-            float(c) for c in self.inertia.to_principal(np.array(vector)))
+        if world:
+            principal = None
+        elif self.inertia.is_principal_frame:     # (no numpy: a flood makes 1000 a second)
+            principal = tuple(float(c) for c in vector)
+        else:
+            principal = tuple(float(c) for c in self.inertia.to_principal(np.array(vector)))
         return TorqueCommand(tuple(vector), world, received_ns, principal, stamp_ns)
 
     def command(self, vector, world, now_ns, force=_ZERO, stamp_ns=None):
