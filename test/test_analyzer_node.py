@@ -6,6 +6,9 @@ Both nodes run as separate processes; the test reads the analyzer's
 """
 
 import math
+import os
+import subprocess
+import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import WrenchStamped
@@ -434,3 +437,28 @@ def test_disturbances_keep_the_balance_laws_ok(launch, probe):
     e = np.array([m.data for m in energy])
     assert np.ptp(e) / e[0] > 0.01
     stop_cleanly(analyzer, sim)
+
+
+def _threads_after(code, env):
+    """Run ``code`` in a fresh interpreter; the number of its threads afterwards."""
+    script = code + '; import os; print(len(os.listdir("/proc/self/task")))'
+    out = subprocess.run([sys.executable, '-c', script], capture_output=True, text=True,
+                         env=env, timeout=60, check=True)
+    return int(out.stdout.split()[-1])
+
+
+@pytest.mark.parametrize('module', ['analyzer', 'entry'])
+def test_node_processes_run_numpy_on_one_blas_thread_unless_told_otherwise(module):
+    """
+    Idle OpenBLAS workers spin after each call: the analyzer at 1 kHz paid 12 % for one.
+
+    Both ways a node starts: ``python -m rigid_body_dynamics.nodes.<node>`` and the
+    console entry point (which imports the node module, and numpy, after ``entry``).
+    """
+    env = {k: v for k, v in os.environ.items() if k != 'OPENBLAS_NUM_THREADS'}
+    first = f'import os, rigid_body_dynamics.nodes.{module}, numpy'
+    ours = _threads_after(f'{first}; assert os.environ["OPENBLAS_NUM_THREADS"] == "1"', env)
+    if (os.cpu_count() or 1) > 1:     # numpy first: its OpenBLAS keeps a worker per extra core
+        assert _threads_after(f'import numpy, rigid_body_dynamics.nodes.{module}', env) > ours
+    _threads_after(f'{first}; assert os.environ["OPENBLAS_NUM_THREADS"] == "2"',
+                   dict(env, OPENBLAS_NUM_THREADS='2'))
