@@ -6,7 +6,7 @@ message: at 1 kHz of Odometry that alone is about a quarter of a core here.
 ``Intake`` keeps its subscriptions on a hidden helper node (``_<node>_intake``,
 same namespace and context) that no executor spins, so nothing takes their
 messages but :meth:`Intake.take`, which drains everything pending in one go.
-The owner calls it from a timer (the analyzer: every 10 ms), or blocks in
+The owner calls it from a timer (the analyzer: every 100 ms), or blocks in
 :meth:`Intake.wait` until a message is pending (the simulator's lockstep
 thread: no executor hop between the controller's answer and the next step).
 Messages are taken serialised (``raw``), for :mod:`rigid_body_dynamics.cdr`
