@@ -197,6 +197,14 @@ def test_achieved_rate_is_counted_wake_to_wake_not_to_the_call():
     body.set_paused(True)
     clock.advance(1000 * MS)
     assert pace.achieved() == 0.0
+    body.set_paused(False)
+    pace.anchor()                                # as the node resumes a body
+    clock.advance(5 * MS)
+    assert pace.achieved() == 0.0                # no wake yet since the pause
+    for _ in range(50):                          # 1 s on time: the paused second counts too
+        clock.advance(int(round(pace.due(outbox) * 1e9)))
+    pace.due(outbox)
+    assert 0.45 < pace.achieved() < 0.55
 
 
 def test_commands_act_from_the_step_they_came_in_as_if_stepped_every_deadline():

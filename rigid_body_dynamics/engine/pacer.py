@@ -153,6 +153,7 @@ class Pace:
                 end = self.perf() + AFAP_BATCH
                 while self.perf() < end:
                     body.advance(self.clock(), outbox)
+                self._woke = (self.clock(), body.steps)
                 return AFAP_YIELD
             now = self.clock()
             period = body.dt_ns / self.rtf
@@ -226,17 +227,20 @@ class Pace:
         """
         Return the achieved real-time factor (simulated s per wall s) since the last call.
 
-        In real time measured from wake to wake (the time of the body's latest wake and
-        the steps due then), not to the time of the call: between two wakes the steps
-        due are integrated at the next one, so counting them at the call made a body
-        woken every 20 ms read 0.98-1.02 in a 1 s period while exactly on time.
+        Measured from wake to wake (the time of the body's latest wake and the steps
+        done then), not to the time of the call: in real time the steps due since a
+        wake are integrated at the next one, so counting them at the call made a body
+        woken every 20 ms read 0.98-1.02 in a 1 s period while exactly on time. With
+        no wake since the last call (paused, stalled) it is 0, and the time without a
+        wake counts in the next reading.
         """
         with self.body.lock:
-            now, steps = (self._woke if self.rtf > 0.0 and not self.body.paused
-                          else (self.clock(), self.body.steps))
             then, steps_then = self._stats
+            now, steps = self._woke
+            if now <= then:
+                return 0.0        # no wake since the last call (paused, or stalled)
             self._stats = (now, steps)
-            return (steps - steps_then) * self.body.dt_ns / max(now - then, 1)
+            return (steps - steps_then) * self.body.dt_ns / (now - then)
 
     def take_max_late(self):
         """Return the worst lateness (ms) since the previous call and start over."""
