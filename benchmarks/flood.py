@@ -94,6 +94,28 @@ KINDS = ('valid body torque', 'non-finite torque', 'unknown frame_id')
 COUNTERS = ('accepted', 'rejected_non_finite', 'rejected_frame')
 
 
+def start_flooder(probe, kind):
+    """Start the flooder process with ``kind`` of commands; return it once it floods."""
+    flooder = Process(script(FLOODER) + [kind, str(RATE), str(SECONDS)])
+
+    def started():
+        flooder.log.seek(0)
+        return b'start' in flooder.log.read()
+    try:
+        probe.spin_until(started, 40.0, 'the flooder')
+    except BaseException:
+        flooder.close()
+        raise
+    return flooder
+
+
+def sent_by(flooder):
+    """(commands sent, seconds it took) from a finished flooder's log."""
+    flooder.log.seek(0)
+    line = [ln for ln in flooder.log.read().decode().splitlines() if ln.startswith('sent')][-1]
+    return int(line.split()[1]), float(line.split()[2])
+
+
 def flood(probe, kind):
     """One flood; returns a row of measurements."""
     probe.messages['/diagnostics'].clear()
@@ -110,12 +132,7 @@ def flood(probe, kind):
         probe.messages['/diagnostics'].clear()
         probe.spin_until(lambda: probe.newest_status('torque command') is not None, 10.0,
                          "the simulator's diagnostics")
-        flooder = Process(script(FLOODER) + [kind, str(RATE), str(SECONDS)])
-
-        def started():
-            flooder.log.seek(0)
-            return b'start' in flooder.log.read()
-        probe.spin_until(started, 40.0, 'the flooder')
+        flooder = start_flooder(probe, kind)
         before = probe.newest_status('torque command')
         integ0 = probe.newest_status('integrator')
         n0 = len(odom)
@@ -126,10 +143,7 @@ def flood(probe, kind):
         probe.spin_for(2.5)
         after = probe.newest_status('torque command')
         integ1 = probe.newest_status('integrator')
-        flooder.log.seek(0)
-        sent_line = [ln for ln in flooder.log.read().decode().splitlines()
-                     if ln.startswith('sent')][-1].split()
-        sent, elapsed = int(sent_line[1]), float(sent_line[2])
+        sent, elapsed = sent_by(flooder)
         took = sum(int(after[2][c]) - int(before[2][c]) for c in COUNTERS)
         missed_key = next(k for k in integ1[2] if k.startswith('missed deadlines'))
         missed = int(integ1[2][missed_key]) - int(integ0[2][missed_key])
@@ -152,12 +166,7 @@ def floor(probe):
     flooder = None
     try:
         probe.spin_for(3.0)
-        flooder = Process(script(FLOODER) + [KINDS[0], str(RATE), str(SECONDS)])
-
-        def started():
-            flooder.log.seek(0)
-            return b'start' in flooder.log.read()
-        probe.spin_until(started, 40.0, 'the flooder')
+        flooder = start_flooder(probe, KINDS[0])
         c0, t0 = cpu_seconds(taker.proc.pid), time.monotonic()
         probe.spin_until(lambda: flooder.proc.poll() is not None, SECONDS + 30.0, 'the flood')
         cpu = (cpu_seconds(taker.proc.pid) - c0) / (time.monotonic() - t0)
@@ -166,9 +175,7 @@ def floor(probe):
         if flooder is not None:
             flooder.close()
         taker.close()
-    flooder.log.seek(0)
-    sent = int([ln for ln in flooder.log.read().decode().splitlines()
-                if ln.startswith('sent')][-1].split()[1])
+    sent = sent_by(flooder)[0]
     taker.log.seek(0)
     took = [ln for ln in taker.log.read().decode().splitlines() if ln.startswith('taken')]
     return cpu, (int(took[-1].split()[1]) / sent if took else float('nan'))

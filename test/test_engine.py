@@ -485,7 +485,7 @@ def test_paces_anchor_on_whole_periods_and_spread_over_phases():
 
 
 def test_a_batch_of_commands_counts_and_holds_as_one_by_one():
-    """command_batch: the counters and the held command equal command() called per message."""
+    """A batch applied whole: the counters and the held command equal command() per message."""
     rng = np.random.default_rng(5)
     vectors = rng.normal(scale=0.3, size=(40, 3))
     vectors[[3, 17]] = np.nan
@@ -495,12 +495,13 @@ def test_a_batch_of_commands_counts_and_holds_as_one_by_one():
     one, many = make_body(max_torque=0.25), make_body(max_torque=0.25)
     for v, f in zip(vectors, forces):
         one.command(v, False, 7, force=tuple(f))
-    events = many.command_batch(vectors, False, 7, forces)
+    whole = many.batch(vectors, False, forces)
+    events = whole.apply(0, whole.size, 7)
     assert many.counts == one.counts and many.command_held == one.command_held
     assert events == {'accepted', 'clipped', 'force_ignored', 'rejected_non_finite'}
     assert many.counts['rejected_non_finite'] == 3 and many.counts['force_ignored'] == 2
     nothing = make_body()
-    assert nothing.command_batch(np.full((2, 3), np.nan), True, 0) == {'rejected_non_finite'}
+    assert nothing.batch(np.full((2, 3), np.nan), True).apply(0, 2, 0) == {'rejected_non_finite'}
     assert nothing.command_held is None
     # in slices (what a pace does, a slice per step): after each slice, as one by one
     sliced, ref = make_body(max_torque=0.25), make_body(max_torque=0.25)

@@ -348,20 +348,14 @@ class BodySimulation:
             self.command_held = self._make_command(vector, bool(world), int(now_ns), stamp_ns)
             return events
 
-    def command_batch(self, vectors, world, now_ns, forces=None):
+    def batch(self, vectors, world, forces=None):
         """
-        Take many commands at once, as :meth:`command` one after the other would.
+        Check many commands at once: a :class:`CommandBatch` to apply in slices.
 
         ``vectors`` (N, 3) N m, all body or all ``world`` frame; ``forces`` (N, 3)
-        or None. Every command is counted (non-finite ones refused, components
-        beyond ``max_torque`` clipped, forces ignored); the last finite one is
-        held. Returns the set of events that happened.
+        or None. Applied whole (``apply(0, N, now_ns)``) it counts and holds as
+        :meth:`command` one after the other would.
         """
-        batch = self.batch(vectors, world, forces)
-        return batch.apply(0, batch.size, now_ns)
-
-    def batch(self, vectors, world, forces=None):
-        """Check these commands at once: a :class:`CommandBatch` to apply in slices."""
         with self.lock:
             return CommandBatch(self, vectors, world, forces)
 
@@ -416,6 +410,10 @@ class BodySimulation:
         self._base_stale = self._base_stale or bool(torqued)
         # the body torque of this step, in full only when a snapshot asks (not every step)
         self._held = (torque, torque_world, field)
+        self._ticks(outbox)
+
+    def _ticks(self, outbox):
+        """Put the current step's snapshot and IMU sample in ``outbox`` if it is their tick."""
         if self.steps % self.publish_every == 0:
             outbox.append(self.snapshot())
         if self.imu_every and self.steps % self.imu_every == 0:
@@ -452,10 +450,7 @@ class BodySimulation:
             self.stepper.free_steps(run)
             self.steps += run
             count -= run
-            if self.steps % publish == 0:
-                outbox.append(self.snapshot())
-            if imu and self.steps % imu == 0:
-                outbox.append(self.imu_sample())
+            self._ticks(outbox)
         return True
 
     def first_items(self):

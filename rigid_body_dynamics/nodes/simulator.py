@@ -10,9 +10,10 @@ an engine :class:`~rigid_body_dynamics.engine.pacer.Pace`, and its state
 messages come from a :class:`~.state_publisher.StatePublisher`.
 
 Threads. Integration and state publishing run on one steady-clock thread,
-woken at the body's ticks (a step that publishes, and at least every 10 ms):
-it takes the torque commands that came, with their receive times, and
-integrates the due steps, each with the command newest at its deadline (see
+woken at the body's ticks (a step that publishes, and at least every
+COMMAND_LOOK = 20 ms): it takes the torque commands that came, with their
+receive times, and integrates the due steps, each with the command newest at
+its deadline (see
 :class:`~rigid_body_dynamics.engine.pacer.Pace`). Services, parameter changes
 and diagnostics run on the executor; both sides share the body under its
 lock.
