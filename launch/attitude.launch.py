@@ -3,24 +3,28 @@ Start the simulator, the analyzer and the Poinsot markers on a preset (full ROS 
 
     ros2 launch rigid_body_dynamics attitude.launch.py preset:=tennis_racket
     ros2 launch rigid_body_dynamics attitude.launch.py namespace:=sat1 real_time_factor:=4.0
+    ros2 launch rigid_body_dynamics attitude.launch.py preset:=tennis_racket rviz:=true
 
 Parameters come from config/<preset>.yaml (shared values under /**); the
-arguments below override them.
+arguments below override them. ``rviz:=true`` also starts RViz with the
+package's rviz/attitude.rviz (TF, the odom pose, the applied torque, the
+Poinsot and momentum-sphere markers) in the same namespace.
 """
 
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
+from launch.conditions import IfCondition
 from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
 from launch_ros.substitutions import FindPackageShare
 
 
 def generate_launch_description():
-    """Launch description: the two nodes, one config file, a few overrides."""
+    """Launch description: the three nodes, one config file, a few overrides, RViz."""
     preset = LaunchConfiguration('preset')
     namespace = LaunchConfiguration('namespace')
-    config = PathJoinSubstitution(
-        [FindPackageShare('rigid_body_dynamics'), 'config', [preset, '.yaml']])
+    share = FindPackageShare('rigid_body_dynamics')
+    config = PathJoinSubstitution([share, 'config', [preset, '.yaml']])
     return LaunchDescription([
         DeclareLaunchArgument('preset', default_value='symmetric_top',
                               description='config/<preset>.yaml to load'),
@@ -35,6 +39,8 @@ def generate_launch_description():
                               description='publish /clock from the simulator'),
         DeclareLaunchArgument('marker_scale', default_value='1.0',
                               description='Poinsot markers: m per rad/s'),
+        DeclareLaunchArgument('rviz', default_value='false',
+                              description='also start rviz2 with rviz/attitude.rviz'),
         Node(package='rigid_body_dynamics', executable='attitude_simulator',
              name='attitude_simulator', namespace=namespace, output='screen',
              parameters=[config, {
@@ -48,4 +54,7 @@ def generate_launch_description():
         Node(package='rigid_body_dynamics', executable='poinsot_visualizer',
              name='poinsot_visualizer', namespace=namespace, output='screen',
              parameters=[{'scale': LaunchConfiguration('marker_scale')}]),
+        Node(package='rviz2', executable='rviz2', name='rviz2', namespace=namespace,
+             arguments=['-d', PathJoinSubstitution([share, 'rviz', 'attitude.rviz'])],
+             condition=IfCondition(LaunchConfiguration('rviz'))),
     ])

@@ -16,6 +16,7 @@ import argparse
 import json
 import sys
 
+from . import optional
 from .bags import BagError, read_trajectory
 from .physics.analysis import analyse, Tolerances
 
@@ -44,9 +45,10 @@ def main(argv=None):
     if args.inertia is not None and len(args.inertia) not in (3, 6):
         parser.error('--inertia takes 3 moments or 6 tensor elements')
     try:
+        optional.require('rosbags')
         traj, info = read_trajectory(args.path, args.odom_topic, args.torque_topic,
                                      args.inertia, args.start, args.end)
-    except BagError as err:
+    except (BagError, optional.MissingDependency) as err:
         print(f'rigid_body_analyze: {err}', file=sys.stderr)
         return 2
     tolerances = Tolerances(energy=args.energy_tolerance, momentum=args.momentum_tolerance,

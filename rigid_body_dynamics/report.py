@@ -27,7 +27,7 @@ import sys
 
 import numpy as np
 
-from . import report_page
+from . import optional, report_page
 from .bags import BagError, BagWriter, INERTIA, ODOMETRY, read_trajectory, WRENCH
 from .physics import estimators, INTEGRATORS, momentum_sphere, presets, quaternions, simulate
 from .physics.analysis import analyse, Trajectory
@@ -383,6 +383,8 @@ def main(argv=None):
     args = parser.parse_args(argv)
     gyro = None
     try:
+        optional.require('matplotlib', 'plotly',
+                         *(('rosbags',) if args.bag or args.record else ()))
         if args.bag:
             run = read_trajectory(args.bag)[0]
         elif args.record:
@@ -409,7 +411,7 @@ def main(argv=None):
             else:
                 run = offline_run(name, args.integrator, duration, args.dt, progress)
         figures, rows = make_report(run, args.out, gyro)
-    except ValueError as err:
+    except (ValueError, optional.MissingDependency) as err:
         print(f'rigid_body_report: {err}', file=sys.stderr)
         return 2
     print(f'wrote {os.path.join(args.out, "index.html")} and {len(figures)} figures: '

@@ -44,6 +44,7 @@ def test_colcon_build_and_ros2_run_lookup(tmp_path, probe, monkeypatch):
     share = os.path.join(prefix, 'share', 'rigid_body_dynamics')
     assert os.path.exists(os.path.join(share, 'launch', 'attitude.launch.py'))
     assert os.path.exists(os.path.join(share, 'config', 'tennis_racket.yaml'))
+    assert os.path.exists(os.path.join(share, 'rviz', 'attitude.rviz'))
 
     site = os.path.relpath(sysconfig.get_paths()['purelib'], sys.prefix)
     assert os.path.isdir(os.path.join(prefix, site, 'rigid_body_dynamics'))

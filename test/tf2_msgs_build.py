@@ -4,7 +4,7 @@ Build a tf2_msgs-compatible interface package for the tests (there is no tf2_msg
 The package in ``test/interfaces/tf2_msgs`` has Jazzy's one definition the
 simulator needs, ``TFMessage.msg`` = ``geometry_msgs/TransformStamped[]
 transforms``; rosidl generates its C, C++ and Python type support from it
-with the registry's rosidl / ament_cmake wheels (requirements.txt), built by
+with the registry's rosidl / ament_cmake wheels (requirements/common.txt), built by
 colcon against the test venv. Its RIHS01 type hash depends only on the field
 names and types, so it equals Jazzy's, which :func:`build` checks. Built once
 per venv and source version, under ``<venv>/tf2_msgs-build/<key>`` (about 10 s).

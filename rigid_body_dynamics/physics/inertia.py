@@ -135,10 +135,12 @@ class Inertia:
         if rotation.shape != (3, 3) or np.linalg.det(rotation) < 0.0 \
                 or not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-12):
             raise ValueError('rotation must be a proper 3x3 rotation matrix')
-        rotation.setflags(write=False)
-        self.rotation = rotation
         #: Quaternion (x, y, z, w) of ``rotation``: principal -> body.
         self.quaternion = Rotation.from_matrix(rotation).as_quat()
+        # Read-only from here on, so it is made read-only after the library
+        # calls: scipy < 1.12 refuses read-only arrays (Cython memoryviews).
+        rotation.setflags(write=False)
+        self.rotation = rotation
         self._identity = bool(np.array_equal(rotation, np.eye(3)))
 
     @classmethod

@@ -1,0 +1,47 @@
+"""
+The third-party modules that only some tools need, and the one-line error when one is missing.
+
+The nodes and the physics need numpy, scipy and the ROS messages only. The
+report needs matplotlib and plotly, the bag tools rosbags; a ROS user who never
+runs them may not have them (plotly has no rosdep key, so ``rosdep install``
+cannot bring it). A tool calls :func:`require` first, before any work, and a
+missing module ends it with one line saying what to install and exit status 2,
+never with a traceback.
+"""
+
+import importlib
+
+#: module -> (what to install with apt on Ubuntu 24.04, with pip; rosdep key or None).
+#: package.xml declares each module that has a rosdep key (test_manifest checks it).
+OPTIONAL = {
+    'matplotlib': ('sudo apt install python3-matplotlib', 'pip install matplotlib',
+                   'python3-matplotlib'),
+    'plotly': ('sudo apt install python3-plotly', 'pip install plotly', None),
+    'rosbags': (None, 'pip install rosbags', 'python3-rosbags-pip'),
+}
+
+
+class MissingDependency(ImportError):
+    """An optional module a tool needs is not installed; the text says what to install."""
+
+
+def require(*modules):
+    """
+    Import ``modules`` (names in :data:`OPTIONAL`) or raise MissingDependency naming all missing.
+
+    The message is one line: what is missing and the command that installs it.
+    """
+    missing = []
+    for name in modules:
+        try:
+            importlib.import_module(name)
+        except ImportError:
+            missing.append(name)
+    if missing:
+        how = []
+        for name in missing:
+            apt, pip, _key = OPTIONAL[name]
+            how.append(f'{apt} (or {pip})' if apt else pip)
+        verb = 'is' if len(missing) == 1 else 'are'
+        raise MissingDependency(f'{" and ".join(missing)} {verb} not installed; install with '
+                                + '; '.join(how))
