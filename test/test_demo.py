@@ -20,6 +20,7 @@ def test_demo_runs_both_nodes_and_prints_the_analyzers_findings():
     assert out.returncode == 0, out.stderr
     assert 'started attitude_simulator' in out.stdout and 'attitude_analyzer finds' in out.stdout
     assert 'exit codes 0, 0' in out.stdout
+    assert 'WARN' not in out.stdout + out.stderr      # start-up is no missed deadline
     errors = _relative_errors(out.stdout)
     assert len(errors) == 2 and max(errors) < 1e-9
     assert 'conservation: conserved' in out.stdout

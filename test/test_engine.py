@@ -173,6 +173,43 @@ def test_pace_wakes_at_ticks_counts_lateness_and_drops_a_backlog():
     assert pace.due(outbox) == pytest.approx(pacer.COMMAND_LOOK, abs=1e-3)  # at least every 20 ms
 
 
+def test_the_schedule_starts_when_its_thread_does_not_at_construction():
+    """Getting ready (DDS, imports, a busy machine) is no missed deadline: issue 22's demo."""
+    from rigid_body_dynamics.engine import Loop, Member
+
+    class OneCycle:
+        """A stop event that lets Loop.run do one cycle."""
+
+        def __init__(self):
+            self.looks = 0
+
+        def is_set(self):
+            self.looks += 1
+            return self.looks > 1
+
+        def wait(self, _seconds):
+            pass
+    clock = FakeClock()
+    backlogs = []
+    paces = [Pace(make_body(), rtf, clock=clock, perf=clock.perf, on_backlog=backlogs.append)
+             for rtf in (1.0, 4.0)]
+    clock.advance(int(0.4e9))                      # 0.4 s from construction to the thread
+    loop = Loop([Member(p, lambda item: None) for p in paces], clock=clock.perf,
+                perf=clock.perf)
+    loop.run(OneCycle())
+    assert backlogs == [] and [p.body.steps for p in paces] == [0, 0]
+    assert [p.missed for p in paces] == [0, 0]
+    for _ in range(4):                             # the 4x body's ticks: every 2.5 ms
+        clock.advance(2501 * 1000)                 # (1 us on: float due times)
+        loop.cycle()
+    assert [p.body.steps for p in paces] == [10, 40] and [p.missed for p in paces] == [0, 0]
+    # anchored at construction instead, the same wait is a backlog dropped with a warning
+    late = Pace(make_body(), 4.0, clock=clock, perf=clock.perf, on_backlog=backlogs.append)
+    clock.advance(int(0.4e9))
+    late.due([])
+    assert backlogs == [1600]
+
+
 def test_achieved_rate_is_counted_wake_to_wake_not_to_the_call():
     """A body woken every 20 ms (50 Hz ticks) reads 1 in every 1 s period, wherever it is read."""
     clock = FakeClock()

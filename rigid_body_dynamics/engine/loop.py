@@ -121,7 +121,13 @@ class Loop:
         return max(0.0, min(wait, self._next_diagnostics - self.clock(), LONGEST_WAIT))
 
     def run(self, stop):
-        """Cycle until the event ``stop`` is set, sleeping on it between cycles."""
+        """
+        Begin every member's schedule now, then cycle until the event ``stop`` is set.
+
+        Sleeps on ``stop`` between cycles.
+        """
+        for member in self.members:
+            member.pace.begin()
         while not stop.is_set():
             wait = self.cycle()
             if wait > 0.0:
