@@ -93,3 +93,20 @@ def test_one_clock_source_only(launch):
     proc = launch(FLEET, '-p', 'publish_clock:=true', '--', '--bodies', '2', name='clocks')
     assert proc.wait(20.0) == 1
     assert 'publish_clock is set for 2 bodies' in proc.output()
+
+
+def test_an_overloaded_fleet_of_128_bodies_exits_within_5_s_of_sigint(launch, probe):
+    """ros2 launch escalates to SIGTERM 5 s after SIGINT: teardown must fit (issue 22)."""
+    proc = launch(FLEET, '-p', 'preset:=tennis_racket', '--', '--bodies', '128', name='fleet')
+    probe.subscribe(Odometry, '/body128/odom')
+    probe.wait_for('/body128/odom', 10, timeout=120.0)
+    # the first body and the last (in the last of 8 DDS participants) serve their services
+    for k in (1, 128):
+        response = probe.call(SetBool, f'/body{k}/attitude_simulator/pause',
+                              SetBool.Request(data=True), timeout=30.0)
+        assert response.success
+    code, seconds = proc.stop(timeout=20.0)
+    assert code == 0, proc.output()[-3000:]
+    # 128 bodies in one participant took 7-8 s here (Fast DDS' teardown is quadratic)
+    assert seconds < 5.0, proc.output()[-3000:]
+    assert '8 DDS participants' in proc.output()

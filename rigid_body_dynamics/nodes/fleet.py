@@ -4,8 +4,10 @@ attitude_fleet: many bodies in one process, each a full attitude_simulator in it
 Every body is an ``AttitudeSimulator`` in ``/<name>``, with the topics, services, parameters
 and diagnostics of ``attitude_simulator --ros-args -r __ns:=/<name>``. ``-p`` sets every body,
 a parameters file one (``/<name>/attitude_simulator``) or all (``/**/attitude_simulator``).
-One interpreter, one DDS participant and one engine Loop thread serve all bodies (benchmarks/
-bodies.py). One body at most publishes /clock; bodies sharing frames do not broadcast /tf; an
+One interpreter, one executor and one engine Loop thread serve all bodies (benchmarks/
+bodies.py); the bodies are spread over one DDS participant per BODIES_PER_PARTICIPANT
+(Fast DDS tears a participant's entities down in a time that grows with the square of their
+number). One body at most publishes /clock; bodies sharing frames do not broadcast /tf; an
 as-fast-as-possible body makes the others late (run it in its own process).
 
 ``attitude_fleet [--bodies N] [--prefix body] [--names a,b,...] [--ros-args ...]``
@@ -17,6 +19,8 @@ import sys
 import threading
 
 import rclpy
+from rclpy.context import Context
+from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
 from .simulator import AttitudeSimulator, DIAGNOSTIC_PERIOD, integration_loop, NODE_NAME
@@ -40,14 +44,28 @@ def body_names(bodies, prefix, names):
     return out
 
 
+#: Bodies per DDS participant (rclpy Context). Destroying a participant's entities one by one
+#: costs Fast DDS time that grows with the square of their number: 96 bodies (5376 entities)
+#: took 4.1-4.4 s to tear down in one participant, 1.3 s in six (benchmarks/RESULTS.md), so a
+#: fleet did not exit within the 5 s that ros2 launch waits after SIGINT.
+BODIES_PER_PARTICIPANT = 16
+
+
 class Fleet:
     """The bodies of one process and the thread that steps them."""
 
-    def __init__(self, names, **kwargs):
+    def __init__(self, names, args=None, **kwargs):
         self._logger = rclpy.logging.get_logger('attitude_fleet')
         self.nodes, self._stop, self._thread = [], threading.Event(), None
+        self._contexts = []          # participants after the first (the default context)
         try:
-            for name in names:
+            for k, name in enumerate(names):
+                if k and k % BODIES_PER_PARTICIPANT == 0:
+                    context = Context()
+                    rclpy.init(args=args, context=context,
+                               signal_handler_options=SignalHandlerOptions.NO)
+                    self._contexts.append(context)
+                    kwargs['context'] = context
                 self.nodes.append(AttitudeSimulator(namespace='/' + name, **kwargs))
             clocks = [n.get_namespace() for n in self.nodes if n.publishes_clock]
             if len(clocks) > 1:
@@ -56,12 +74,12 @@ class Fleet:
                     f'{", ..." if len(clocks) > 3 else ""}); /clock must have one source, so '
                     'set it for one body only (key /<name>/attitude_simulator)')
         except Exception:
-            for node in self.nodes:
-                node.destroy_node()
+            self._destroy()
             raise
         self._untangle_tf()
         self.context = self.nodes[0].context     # one context, shared by every body
-        self._logger.info(f'{len(names)} bodies in this process, one integration thread')
+        self._logger.info(f'{len(names)} bodies in this process, one integration thread, '
+                          f'{1 + len(self._contexts)} DDS participants')
 
     def _untangle_tf(self):
         """Stop /tf for bodies whose (world, body) frames another body also broadcasts."""
@@ -89,10 +107,20 @@ class Fleet:
         self._thread.start()
 
     def stop(self):
-        """Stop the integration thread and wait for it."""
+        """Stop the integration thread and wait for it; destroy the bodies and participants."""
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
+        self._destroy()
+
+    def _destroy(self):
+        """Destroy every body, then the participants beyond the default one (run() ends that)."""
+        nodes, self.nodes = self.nodes, []
+        for node in nodes:
+            node.destroy_node()
+        for context in self._contexts:
+            context.try_shutdown()
+        self._contexts = []
 
 
 def main(args=None, early=None):
@@ -111,7 +139,7 @@ def main(args=None, early=None):
         names = body_names(options.bodies, options.prefix, options.names)
     except ConfigurationError as err:
         parser.error(str(err))
-    return run(lambda: Fleet(names), NODE_NAME, argv, early=early,
+    return run(lambda: Fleet(names, args=argv), NODE_NAME, argv, early=early,
                on_start=Fleet.start, on_stop=Fleet.stop)
 
 
