@@ -249,7 +249,7 @@ def _ros_environment():
 
 def main(argv=None):
     """Console entry point: print theory against simulation (nodes, or --offline)."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser = argparse.ArgumentParser(prog='rigid_body_demo', description=__doc__.splitlines()[1])
     parser.add_argument('--preset', default=None,
                         help=f'preset name, or {CLOSED_LOOP} (default: a tour of all three)')
     parser.add_argument('--integrator', default='exact', choices=sorted(INTEGRATORS))

@@ -360,7 +360,8 @@ Measured against theory by the one analysis (physics/analysis.py):</p>
 
 def main(argv=None):
     """Console entry point."""
-    parser = argparse.ArgumentParser(description='Figures and an HTML page about a run.')
+    parser = argparse.ArgumentParser(prog='rigid_body_report',
+                                     description='Figures and an HTML page about a run.')
     source = parser.add_mutually_exclusive_group()
     source.add_argument('--preset', help='simulate this preset offline (default symmetric_top)')
     source.add_argument('--bag', help='a rosbag2 folder or a .mcap / .db3 file to report on')

@@ -466,21 +466,17 @@ def test_without_tf2_msgs_the_simulator_says_so_and_runs(launch, probe):
     stop_cleanly(proc)
 
 
-def test_readme_sensor_noise_yaml_gives_that_gyro(launch, probe, tmp_path):
+def test_the_manuals_gyro_yaml_gives_that_gyro(launch, probe, tmp_path):
     """
-    The parameters file of README's "Sensor noise", as a user passes it, sets the imu stream.
+    The parameters file of the manual's "noisy IMU" guide, as a user passes it, sets the imu.
 
     N = 1e-4 at 200 Hz: angular velocity covariance N^2 * 200 = 2e-6, orientation 0.002^2;
     the stream is seed 7's (the offline model's at every index; the bias bit for bit) and
     imu minus truth minus bias has N sqrt(200) per sample (within 10 %).
     """
-    import re
     from sensor_msgs.msg import Imu
     from rigid_body_dynamics.physics.sensors import GyroErrors, GyroModel
-    readme = open(os.path.join(os.path.dirname(__file__), '..', 'README.md')).read()
-    block = re.search(r'<!-- sensor-noise-example -->\n```yaml\n(.*?)```', readme, re.S).group(1)
-    params = tmp_path / 'gyro.yaml'
-    params.write_text(block)
+    params = os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples', 'gyro.yaml')
     proc = launch(SIM, '--params-file', str(params), '-p', 'publish_clock:=true',
                   '-p', 'real_time_factor:=4.0', name='sim_yaml')
     imu = probe.subscribe(Imu, 'imu')

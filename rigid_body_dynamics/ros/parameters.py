@@ -9,7 +9,6 @@ then checked here, with a reason for every refusal.
 
 from dataclasses import dataclass
 import math
-import textwrap
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rcl_interfaces.msg import SetParametersResult
@@ -136,15 +135,16 @@ class Param:
                                      f'got {value!r}')
         return value
 
-    def readme(self):
-        """Return the README line of this parameter (wrapped at 79 columns)."""
-        extras = [self.kind, self.shown]
-        if self.read_only:
-            extras.append('read-only')
+    def row(self):
+        """Return this parameter's row of the manual's table (Markdown)."""
+        limits = ''
         if self.low is not None and self.high is not None and self.kind in ('double', 'int'):
-            extras.append(f'{self.low:g} .. {self.high:g}')
-        line = f'- `{self.name}` ({", ".join(extras)}) — {self.text}'
-        return textwrap.fill(line, width=79, subsequent_indent='  ', break_on_hyphens=False)
+            limits = f'{self.low:g} .. {self.high:g}'
+        elif self.choices:
+            limits = ', '.join(self.choices)
+        cells = [f'`{self.name}`', self.kind, self.shown, limits,
+                 'yes' if self.read_only else '', self.text]
+        return '| ' + ' | '.join(c.replace('|', '\\|') for c in cells) + ' |'
 
 
 class ParameterTable:
@@ -185,6 +185,8 @@ class ParameterTable:
         values.update({p.name: p.value for p in params if p.name in self.params})
         return check_change(node.get_logger(), self.validate, values)
 
-    def readme(self):
-        """Return the README's parameter list, one entry per parameter, in declaration order."""
-        return '\n'.join(p.readme() for p in self.params.values())
+    def markdown(self):
+        """Return the manual's parameter table (Markdown), in declaration order."""
+        return '\n'.join(['| name | type | default | range | read-only | meaning |',
+                          '| --- | --- | --- | --- | --- | --- |']
+                         + [p.row() for p in self.params.values()])

@@ -1,0 +1,179 @@
+"""
+The topics and services of each node: the contract the manual's node pages are made from.
+
+One :class:`Interfaces` table per node lists what it publishes, subscribes
+and serves, with the message type, the frame or unit, and when it exists (a
+parameter, tf2_msgs being importable). ``doc/generate.py`` renders them into
+the node reference; ``test/test_docs.py`` starts each node and compares the
+table with what the running node has on the ROS graph, so the two cannot
+drift. Names are as the node creates them (relative, ``~/`` private, or
+absolute); the parameter services, ``/rosout`` and ``/parameter_events`` that
+every rclpy node has are listed once, in :data:`STANDARD`.
+"""
+
+from dataclasses import dataclass
+
+#: What every rclpy node has; the node pages mention them once, not per node.
+STANDARD = {
+    'pub': {'/rosout': 'rcl_interfaces/msg/Log',
+            '/parameter_events': 'rcl_interfaces/msg/ParameterEvent'},
+    'srv': {f'~/{name}': f'rcl_interfaces/srv/{kind}' for name, kind in (
+        ('describe_parameters', 'DescribeParameters'),
+        ('get_parameter_types', 'GetParameterTypes'),
+        ('get_parameters', 'GetParameters'),
+        ('list_parameters', 'ListParameters'),
+        ('set_parameters', 'SetParameters'),
+        ('set_parameters_atomically', 'SetParametersAtomically'))}
+    | {'~/get_type_description': 'type_description_interfaces/srv/GetTypeDescription'},
+}
+
+HEADINGS = {'sub': 'Subscribed topics', 'pub': 'Published topics', 'srv': 'Services'}
+
+
+@dataclass(frozen=True)
+class Interface:
+    """One topic or service of a node."""
+
+    kind: str          # 'pub', 'sub' or 'srv'
+    name: str          # as the node creates it: relative, ~/private or /absolute
+    type: str          # e.g. 'nav_msgs/msg/Odometry'
+    text: str          # what it carries: units, frame, QoS
+    when: str = ''     # the condition under which it exists ('' = always)
+
+
+class Interfaces:
+    """The topics and services of the node ``node`` (its default name)."""
+
+    def __init__(self, node, items):
+        self.node = node
+        self.items = tuple(items)
+
+    def resolved(self, namespace='/', present=lambda when: True):
+        """
+        Return {kind: {full name: type}} in ``namespace``, standard interfaces included.
+
+        ``present(when)`` says whether a conditional item exists in the run at hand.
+        """
+        out = {kind: {} for kind in HEADINGS}
+        base = namespace.rstrip('/')
+        for kind, names in STANDARD.items():
+            for name, msg_type in names.items():
+                out[kind][self._full(name, base)] = msg_type
+        for item in self.items:
+            if not item.when or present(item.when):
+                out[item.kind][self._full(item.name, base)] = item.type
+        return out
+
+    def _full(self, name, base):
+        if name.startswith('/'):
+            return name
+        if name.startswith('~/'):
+            return f'{base}/{self.node}/{name[2:]}'
+        return f'{base}/{name}'
+
+    def markdown(self):
+        """The node page's topic and service sections (Markdown; headings at level 2)."""
+        lines = []
+        for kind, heading in HEADINGS.items():
+            items = [i for i in self.items if i.kind == kind]
+            lines += [f'## {heading}', '']
+            if not items:
+                lines += ['None.', '']
+                continue
+            lines += ['| name | type | meaning | exists |', '| --- | --- | --- | --- |']
+            for i in items:
+                lines.append(f'| `{i.name}` | `{i.type}` | {i.text} | {i.when or "always"} |')
+            lines.append('')
+        lines += ['Like every rclpy node it also has `/rosout`, `/parameter_events` and the '
+                  'parameter services (`~/list_parameters`, `~/get_parameters`, '
+                  '`~/set_parameters`, ...) and `~/get_type_description`.', '']
+        return '\n'.join(lines)
+
+
+SIMULATOR = Interfaces('attitude_simulator', [
+    Interface('sub', 'torque_cmd', 'geometry_msgs/msg/WrenchStamped',
+              'Torque command (N m) in `body_frame` (or empty frame id) or `world_frame`; held '
+              'until replaced or `torque_timeout`; non-finite values and unknown frames are '
+              'refused and counted. Reliable, depth 1000, taken in batches by the integration '
+              'thread (held by the hidden helper node `_attitude_simulator_intake`).'),
+    Interface('pub', 'odom', 'nav_msgs/msg/Odometry',
+              '`world_frame` -> `body_frame`: orientation body -> world, twist.angular = omega '
+              '(rad/s, body frame); position 0.'),
+    Interface('pub', 'orientation', 'geometry_msgs/msg/QuaternionStamped',
+              'Body -> world, `world_frame`.', 'if in `state_topics`'),
+    Interface('pub', 'angular_velocity', 'geometry_msgs/msg/Vector3Stamped',
+              'omega (rad/s), `body_frame`.', 'if in `state_topics`'),
+    Interface('pub', 'angular_momentum', 'geometry_msgs/msg/Vector3Stamped',
+              'L (kg m^2/s), `world_frame`; constant when torque-free.', 'if in `state_topics`'),
+    Interface('pub', 'angular_momentum_body', 'geometry_msgs/msg/Vector3Stamped',
+              'L (kg m^2/s), `body_frame`.', 'if in `state_topics`'),
+    Interface('pub', 'applied_torque', 'geometry_msgs/msg/WrenchStamped',
+              'The body-frame torque (N m) held over the step that ended at the stamp: the '
+              'command (zero after a timeout) plus disturbances.', 'if in `state_topics`'),
+    Interface('pub', 'imu', 'sensor_msgs/msg/Imu',
+              'REP 145 gyro at `imu_rate`: measured angular velocity and orientation with the '
+              'gyro error model and their covariances; no acceleration (covariance[0] = -1).',
+              'if `publish_imu`'),
+    Interface('pub', '~/imu_bias', 'geometry_msgs/msg/Vector3Stamped',
+              'The gyro\'s true bias (rad/s, `body_frame`) at each imu stamp.', 'if `publish_imu`'),
+    Interface('pub', 'inertia', 'geometry_msgs/msg/InertiaStamped',
+              'The inertia tensor (kg m^2, `body_frame`); transient local (latched); mass 0.'),
+    Interface('pub', '/clock', 'rosgraph_msgs/msg/Clock',
+              'Simulated time; best effort, depth 1.', 'if `publish_clock`'),
+    Interface('pub', '/tf', 'tf2_msgs/msg/TFMessage',
+              '`world_frame` -> `body_frame` at every odom stamp (rotation only); tf2_ros\' '
+              'broadcaster QoS.', 'if `publish_tf` and tf2_msgs is importable'),
+    Interface('pub', '/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray',
+              '1 Hz: `<node>: integrator` and `<node>: torque command` statuses.'),
+    Interface('pub', '~/real_time_factor', 'std_msgs/msg/Float64',
+              'Achieved real-time factor, 1 Hz (simulated over wall time between wakes; 0 '
+              'while paused).'),
+    Interface('srv', '~/reset', 'std_srvs/srv/Trigger',
+              'Back to the initial state; simulated time restarts at 0, the command is cleared.'),
+    Interface('srv', '~/pause', 'std_srvs/srv/SetBool',
+              '`true` freezes the state (nothing published), `false` resumes.'),
+])
+
+ANALYZER = Interfaces('attitude_analyzer', [
+    Interface('sub', 'odom', 'nav_msgs/msg/Odometry',
+              'Attitude and angular velocity; best effort, depth 1000, taken every 100 ms '
+              '(hidden helper node `_attitude_analyzer_intake`).'),
+    Interface('sub', 'applied_torque', 'geometry_msgs/msg/WrenchStamped',
+              'Body torque (N m); with torque in the window the balance laws are checked '
+              '(hidden helper node `_attitude_analyzer_intake`).'),
+    Interface('sub', 'inertia', 'geometry_msgs/msg/InertiaStamped',
+              'Latched; used unless the `inertia` parameter is set.'),
+    Interface('pub', 'precession/body_rate', 'std_msgs/msg/Float64',
+              'rad/s: omega about the symmetry axis, body frame (the seed\'s Omega).'),
+    Interface('pub', 'precession/lab_rate', 'std_msgs/msg/Float64',
+              'rad/s: the symmetry axis about L, inertial frame.'),
+    Interface('pub', 'kinetic_energy', 'std_msgs/msg/Float64', 'T (J).'),
+    Interface('pub', 'angular_momentum_norm', 'std_msgs/msg/Float64', '|L| (kg m^2/s).'),
+    Interface('pub', '/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray',
+              'Every `diagnostic_period`: `conservation`, `precession`, `stability`, `input`.'),
+    Interface('srv', '~/reset_baseline', 'std_srvs/srv/Trigger',
+              'Measure drift from the next sample on.'),
+])
+
+POINSOT = Interfaces('poinsot_visualizer', [
+    Interface('sub', 'odom', 'nav_msgs/msg/Odometry', 'The motion to draw; best effort.'),
+    Interface('sub', 'inertia', 'geometry_msgs/msg/InertiaStamped', 'Latched.'),
+    Interface('pub', 'poinsot_markers', 'visualization_msgs/msg/MarkerArray',
+              'In odom\'s `header.frame_id`: namespace `poinsot` (ellipsoid, omega, normal, '
+              'plane, polhode, herpolhode) and `momentum_sphere` (sphere, L, its curve).'),
+])
+
+CONTROLLER = Interfaces('attitude_controller', [
+    Interface('sub', 'odom', 'nav_msgs/msg/Odometry',
+              'The states to answer (taken by its own thread; hidden helper node '
+              '`_attitude_controller_intake`).'),
+    Interface('sub', 'inertia', 'geometry_msgs/msg/InertiaStamped',
+              'Latched; no command before it (its diagonal gives the gains).'),
+    Interface('sub', 'target_orientation', 'geometry_msgs/msg/QuaternionStamped',
+              'Target attitude, body -> world; overrides the parameter.'),
+    Interface('pub', 'torque_cmd', 'geometry_msgs/msg/WrenchStamped',
+              'Torque (N m, body frame) stamped with the stamp of the state it answers.'),
+])
+
+#: Every node's table, by executable name.
+NODES = {t.node: t for t in (SIMULATOR, ANALYZER, POINSOT, CONTROLLER)}
