@@ -19,7 +19,7 @@ sys.path.insert(0, ROOT)
 
 project = 'rigid_body_dynamics'
 author = 'rigid_body_dynamics maintainers'
-copyright = '2026, rigid_body_dynamics maintainers'
+copyright = '2026, rigid_body_dynamics maintainers'  # noqa: A001 (Sphinx's name)
 release = version = '0.2.0'
 
 extensions = [
@@ -46,7 +46,7 @@ nitpicky = False
 # The docstrings write norms as |L|, |omega|, ...: plain text there, substitutions to
 # reStructuredText; these keep them as written.
 rst_prolog = '\n'.join(f'.. |{name}| replace:: \\|{name}\\|'
-                        for name in ('L', 'Omega', 'omega', 'omega_3', 'tau', 'theta'))
+                       for name in ('L', 'Omega', 'omega', 'omega_3', 'tau', 'theta'))
 
 MATHJAX_FILE = 'tex-svg-full.js'
 

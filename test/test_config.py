@@ -9,7 +9,6 @@ declared by the node it starts; the configs agree with the presets.
 import ast
 import glob
 import os
-import re
 
 from geometry_msgs.msg import InertiaStamped
 import pytest
@@ -116,19 +115,3 @@ def test_launch_file_sets_only_declared_parameters_of_installed_executables():
         assert f"'{executable} = rigid_body_dynamics.nodes." in setup
         assert keys <= declared[executable], keys - declared[executable]
     assert "'config'" in open(LAUNCH).read()
-
-
-@pytest.mark.parametrize('node', ['attitude_simulator', 'attitude_analyzer',
-                                  'poinsot_visualizer', 'attitude_controller'])
-def test_readme_parameter_lists_are_made_from_the_tables(node):
-    """The README's parameter list of each node is exactly its table's (declaration = docs)."""
-    from rigid_body_dynamics.nodes import analyzer, controller, poinsot, simulator
-    table = {'attitude_simulator': simulator, 'attitude_analyzer': analyzer,
-             'poinsot_visualizer': poinsot, 'attitude_controller': controller}[node].PARAMETERS
-    readme = open(os.path.join(os.path.dirname(__file__), '..', 'README.md')).read()
-    found = re.search(rf'<!-- parameters: {node} -->\n(.*?)\n<!-- /parameters: {node} -->',
-                      readme, re.S)
-    assert found, f'README has no parameter block for {node}'
-    assert found.group(1) == table.readme(), (
-        f'README parameters of {node} differ from the table; regenerate the block with '
-        f'print({node}.PARAMETERS.readme())')

@@ -15,7 +15,6 @@ from html.parser import HTMLParser
 import os
 from pathlib import Path
 import re
-import shutil
 import subprocess
 import sys
 
@@ -141,7 +140,7 @@ def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs
                 names = (node, f'_{node}_intake') if kind == 'sub' else (node,)
                 for name in names:        # the take-based subscriptions are on a helper node
                     try:
-                        found.update({t: types for t, types in call(name, '/')})
+                        found.update(dict(call(name, '/')))
                     except Exception:                         # not (yet) on the graph
                         pass
                 out[kind] = {t: types[0] for t, types in found.items()}
@@ -186,8 +185,11 @@ PAGES = sorted({p for p, _k, text in BLOCKS if not text.startswith(ON_ROS)})
 
 @pytest.mark.parametrize('page', PAGES)
 def test_the_command_blocks_of_a_page_run_as_written(tmp_path, page):
-    """A reader's session: the page's blocks in order, in one folder (a later one may use
-    what an earlier one made)."""
+    """
+    Run a page's blocks as a reader would: in order, in one folder.
+
+    A later block may use what an earlier one made (a bag, a report).
+    """
     stack = {'.venv': 'pinned', '.venv-jazzy': 'jazzy'}.get(Path(sys.prefix).name)
     if stack is None or Path(sys.prefix).parent != ROOT:
         pytest.skip(f'the blocks call ./dev, and this suite runs outside its venvs ({sys.prefix})')
@@ -243,3 +245,13 @@ def test_the_send_torque_example_turns_the_body_as_euler_says(launch, probe):
     # the torque began within the tick before `first` and ended within the one after `last`
     assert 0.1 / 1.5 * (last - first) * 1e-9 - 1e-9 < gained
     assert gained < 0.1 / 1.5 * (last - first + 2 * period) * 1e-9 + 1e-9
+
+
+def test_the_readme_is_a_short_landing_page_whose_links_resolve():
+    readme = (ROOT / 'README.md').read_text()
+    assert len(readme.splitlines()) < 150
+    first = re.search(r'```bash\n(.*?)```', readme, re.S).group(1)
+    assert first.startswith('./dev demo') and '\n./dev test' in first
+    links = re.findall(r'\]\(([^)#]+)\)', readme)
+    assert len(links) > 20
+    assert [link for link in links if not (ROOT / link).exists()] == []

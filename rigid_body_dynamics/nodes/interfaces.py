@@ -36,7 +36,7 @@ class Interface:
 
     kind: str          # 'pub', 'sub' or 'srv'
     name: str          # as the node creates it: relative, ~/private or /absolute
-    type: str          # e.g. 'nav_msgs/msg/Odometry'
+    type: str          # e.g. 'nav_msgs/msg/Odometry'  # noqa: A003 (a field name)
     text: str          # what it carries: units, frame, QoS
     when: str = ''     # the condition under which it exists ('' = always)
 
@@ -72,7 +72,7 @@ class Interfaces:
         return f'{base}/{name}'
 
     def markdown(self):
-        """The node page's topic and service sections (Markdown; headings at level 2)."""
+        """Return the node page's topic and service sections (Markdown; headings at level 2)."""
         lines = []
         for kind, heading in HEADINGS.items():
             items = [i for i in self.items if i.kind == kind]
@@ -115,13 +115,13 @@ SIMULATOR = Interfaces('attitude_simulator', [
               'gyro error model and their covariances; no acceleration (covariance[0] = -1).',
               'if `publish_imu`'),
     Interface('pub', '~/imu_bias', 'geometry_msgs/msg/Vector3Stamped',
-              'The gyro\'s true bias (rad/s, `body_frame`) at each imu stamp.', 'if `publish_imu`'),
+              "The gyro's true bias (rad/s, `body_frame`) at each imu stamp.", 'if `publish_imu`'),
     Interface('pub', 'inertia', 'geometry_msgs/msg/InertiaStamped',
               'The inertia tensor (kg m^2, `body_frame`); transient local (latched); mass 0.'),
     Interface('pub', '/clock', 'rosgraph_msgs/msg/Clock',
               'Simulated time; best effort, depth 1.', 'if `publish_clock`'),
     Interface('pub', '/tf', 'tf2_msgs/msg/TFMessage',
-              '`world_frame` -> `body_frame` at every odom stamp (rotation only); tf2_ros\' '
+              "`world_frame` -> `body_frame` at every odom stamp (rotation only); tf2_ros' "
               'broadcaster QoS.', 'if `publish_tf` and tf2_msgs is importable'),
     Interface('pub', '/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray',
               '1 Hz: `<node>: integrator` and `<node>: torque command` statuses.'),
@@ -144,7 +144,7 @@ ANALYZER = Interfaces('attitude_analyzer', [
     Interface('sub', 'inertia', 'geometry_msgs/msg/InertiaStamped',
               'Latched; used unless the `inertia` parameter is set.'),
     Interface('pub', 'precession/body_rate', 'std_msgs/msg/Float64',
-              'rad/s: omega about the symmetry axis, body frame (the seed\'s Omega).'),
+              "rad/s: omega about the symmetry axis, body frame (the seed's Omega)."),
     Interface('pub', 'precession/lab_rate', 'std_msgs/msg/Float64',
               'rad/s: the symmetry axis about L, inertial frame.'),
     Interface('pub', 'kinetic_energy', 'std_msgs/msg/Float64', 'T (J).'),
@@ -159,7 +159,7 @@ POINSOT = Interfaces('poinsot_visualizer', [
     Interface('sub', 'odom', 'nav_msgs/msg/Odometry', 'The motion to draw; best effort.'),
     Interface('sub', 'inertia', 'geometry_msgs/msg/InertiaStamped', 'Latched.'),
     Interface('pub', 'poinsot_markers', 'visualization_msgs/msg/MarkerArray',
-              'In odom\'s `header.frame_id`: namespace `poinsot` (ellipsoid, omega, normal, '
+              "In odom's `header.frame_id`: namespace `poinsot` (ellipsoid, omega, normal, "
               'plane, polhode, herpolhode) and `momentum_sphere` (sphere, L, its curve).'),
 ])
 
