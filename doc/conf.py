@@ -40,7 +40,8 @@ autodoc_typehints = 'none'
 # offline: no inventory is fetched (an empty mapping; rosdoc2 adds its own online)
 intersphinx_mapping = {}
 html_theme = 'sphinx_rtd_theme'
-html_static_path = []
+html_static_path = ['_static']
+html_css_files = ['custom.css']
 html_title = 'rigid_body_dynamics manual'
 nitpicky = False
 # The docstrings write norms as |L|, |omega|, ...: plain text there, substitutions to

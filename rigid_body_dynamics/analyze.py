@@ -21,6 +21,17 @@ from .bags import BagError, read_trajectory
 from .physics.analysis import analyse, Tolerances
 
 
+def _tolerance(text):
+    """Parse a tolerance: a finite number > 0 (0 would switch its check off)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
+    if not 0.0 < value < float('inf'):
+        raise argparse.ArgumentTypeError(f'must be a finite number > 0, got {text}')
+    return value
+
+
 def main(argv=None):
     """Console entry point."""
     parser = argparse.ArgumentParser(
@@ -39,7 +50,7 @@ def main(argv=None):
                                 ('momentum-tolerance', 1e-6, 'drift of |L| and L direction'),
                                 ('balance-tolerance', 1e-2, 'balance residual under torque'),
                                 ('rate-tolerance', 1e-6, 'measured against predicted rates')):
-        parser.add_argument(f'--{name}', type=float, default=default,
+        parser.add_argument(f'--{name}', type=_tolerance, default=default,
                             help=f'{text} (default {default:g})')
     args = parser.parse_args(argv)
     if args.inertia is not None and len(args.inertia) not in (3, 6):

@@ -151,3 +151,44 @@ def test_from_samples_drops_bad_samples_and_duplicates():
     # rows 7 and 9 go; row 3's stamp comes back from its duplicate
     assert len(again) == len(traj) - 2 and again.dropped == 3
     assert np.all(np.diff(again.t_ns) > 0)
+
+
+@pytest.mark.parametrize('field', ['energy', 'momentum', 'balance', 'rate', 'growth'])
+@pytest.mark.parametrize('value', [0.0, -1e-6, float('nan'), float('inf')])
+def test_a_tolerance_that_is_not_positive_is_refused_with_the_reason(field, value):
+    """A tolerance of 0 (meant as 'strict') switched the check off: a permanent OK."""
+    from rigid_body_dynamics.physics.analysis import Tolerances
+    with pytest.raises(ValueError, match=f'the {field} tolerance must be a finite number > 0'):
+        Tolerances(**{field: value})
+
+
+def test_a_missing_or_zero_prediction_is_never_a_silent_ok():
+    from rigid_body_dynamics.physics.analysis import compare, ERROR, OK, UNAVAILABLE, WARN
+    missing = compare(1.0, None, 1e-6)
+    assert missing.status == UNAVAILABLE and missing.why == 'no prediction'
+    # a prediction of exactly 0: |measured| against the tolerance, in the unit
+    assert compare(5e-7, 0.0, 1e-6, 'rad/s').status == OK
+    assert compare(5e-5, 0.0, 1e-6, 'rad/s').status == WARN
+    far = compare(1.0, 0.0, 1e-6, 'rad/s')
+    assert far.status == ERROR and 'absolute' in far.why and far.relative_error is None
+    assert compare(1.0 + 5e-7, 1.0, 1e-6).status == OK
+    with pytest.raises(ValueError, match='tolerance must be > 0'):
+        compare(1.0, 1.0, 0.0)
+
+
+@pytest.mark.parametrize('name', ['energy_tolerance', 'momentum_tolerance', 'balance_tolerance',
+                                  'rate_tolerance'])
+def test_the_analyzers_tolerance_parameters_refuse_zero(name):
+    from rigid_body_dynamics.nodes.analyzer import PARAMETERS
+    from rigid_body_dynamics.ros.parameters import ConfigurationError
+    with pytest.raises(ConfigurationError, match=f'{name} must be greater than 0, got 0'):
+        PARAMETERS.params[name].check(0.0)
+    assert PARAMETERS.params[name].check(1e-9) == 1e-9
+
+
+def test_rigid_body_analyze_refuses_a_zero_tolerance(capsys):
+    from rigid_body_dynamics import analyze
+    with pytest.raises(SystemExit) as stop:
+        analyze.main(['any.mcap', '--rate-tolerance', '0'])
+    assert stop.value.code == 2
+    assert '--rate-tolerance: must be a finite number > 0, got 0' in capsys.readouterr().err

@@ -85,18 +85,19 @@ PARAMETERS = ParameterTable([
           low=0.1, high=1e9),
     Param('energy_tolerance', 'double', 1e-6, '1e-6',
           'Relative drift of T in free motion above which conservation is WARN; 100x that is '
-          'ERROR.', low=0.0, high=1.0),
+          'ERROR.', low=0.0, high=1.0, above_low=True),
     Param('momentum_tolerance', 'double', 1e-6, '1e-6',
           'Relative drift of |L| and of the L direction (rad) in free motion above which '
-          'conservation is WARN; 100x that is ERROR.', low=0.0, high=1.0),
+          'conservation is WARN; 100x that is ERROR.', low=0.0, high=1.0, above_low=True),
     Param('balance_tolerance', 'double', 1e-2, '1e-2',
           'Under torque: relative work-energy and impulse-momentum residual above which '
           'conservation is WARN (100x: ERROR). Sampled torque costs an O(dt) quadrature error '
           'at each torque change, so this is looser than the free-motion tolerances.',
-          low=0.0, high=1.0),
+          low=0.0, high=1.0, above_low=True),
     Param('rate_tolerance', 'double', 1e-6, '1e-6',
           'Relative difference between a measured rate or period of the free motion and '
-          'theory above which precession is WARN; 100x that is ERROR.', low=0.0, high=1.0),
+          'theory above which precession is WARN; 100x that is ERROR.', low=0.0, high=1.0,
+          above_low=True),
     Param('stale_timeout', 'double', 1.0, '1.0 s',
           'Input is STALE when no odom arrived for this long (s, steady clock).',
           low=0.0, high=1e6),

@@ -145,6 +145,18 @@ class Tolerances:
     growth: float = 1e-2
     min_samples: int = 20
 
+    def __post_init__(self):
+        """Refuse a tolerance that is not a positive number: 0 meant 'strict' and passed all."""
+        for name in ('energy', 'momentum', 'balance', 'rate', 'growth'):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                    or not math.isfinite(value) or value <= 0.0:
+                raise ValueError(f'the {name} tolerance must be a finite number > 0 (a '
+                                 f'tolerance of 0 would pass nothing), got {value!r}')
+        if isinstance(self.min_samples, bool) or not isinstance(self.min_samples, int) \
+                or self.min_samples < 2:
+            raise ValueError(f'min_samples must be an integer >= 2, got {self.min_samples!r}')
+
 
 @dataclass(frozen=True)
 class Quantity:
@@ -177,16 +189,27 @@ def _level(worst):
 
 
 def compare(measured, predicted, tolerance, unit=''):
-    """Make a :class:`Quantity` of a measurement and its prediction at a relative tolerance."""
+    """
+    Make a :class:`Quantity` of a measurement and its prediction at a relative tolerance.
+
+    ``tolerance`` must be > 0 (ValueError). Without a measurement or without a
+    prediction the quantity is ``unavailable``, saying which is missing; a
+    prediction of exactly 0 has no relative scale, so the measurement is
+    compared on an absolute one: ``|measured|`` against ``tolerance`` (in ``unit``).
+    """
+    if not tolerance > 0.0:
+        raise ValueError(f'a tolerance must be > 0, got {tolerance!r}')
     measured = None if measured is None or not math.isfinite(measured) else float(measured)
     predicted = None if predicted is None or not math.isfinite(predicted) else float(predicted)
     if measured is None:
         return Quantity(None, predicted, UNAVAILABLE, unit, tolerance, 'no measurement')
-    if predicted is None or predicted == 0.0:
-        return Quantity(measured, predicted, OK, unit, tolerance)
+    if predicted is None:
+        return Quantity(measured, None, UNAVAILABLE, unit, tolerance, 'no prediction')
+    if predicted == 0.0:
+        return Quantity(measured, predicted, _level(abs(measured) / tolerance), unit, tolerance,
+                        'compared on an absolute scale: the prediction is 0')
     rel = abs(measured - predicted) / abs(predicted)
-    return Quantity(measured, predicted, _level(rel / tolerance if tolerance else 0.0), unit,
-                    tolerance)
+    return Quantity(measured, predicted, _level(rel / tolerance), unit, tolerance)
 
 
 def unavailable(why, predicted=None, unit=''):

@@ -88,7 +88,9 @@ class Param:
     ``shown``: the default as the README shows it (e.g. '1000.0 Hz', 'preset').
     ``text``: what it means, with units; the descriptor's description and the
     README's text. ``low`` / ``high``: the inclusive range (rclpy enforces it
-    for numbers); ``choices``: allowed strings; ``convert(value)``: a custom
+    for numbers); ``above_low``: ``low`` itself is refused too (a tolerance of 0
+    would switch its check off; rclpy's ranges are inclusive, so the node
+    refuses it with the reason); ``choices``: allowed strings; ``convert(value)``: a custom
     check returning the converted value (ConfigurationError with the reason).
     """
 
@@ -102,6 +104,7 @@ class Param:
     read_only: bool = False
     choices: tuple = ()
     convert: object = None
+    above_low: bool = False
 
     def descriptor(self):
         """Build the ParameterDescriptor of this parameter."""
@@ -121,7 +124,11 @@ class Param:
         if self.kind == 'double':
             low = -math.inf if self.low is None else self.low
             high = math.inf if self.high is None else self.high
-            return as_float(self.name, value, low, high)
+            value = as_float(self.name, value, low, high)
+            if self.above_low and value == low:
+                raise ConfigurationError(f'{self.name} must be greater than {low:g}, got '
+                                         f'{value:g}')
+            return value
         if self.kind.startswith('double['):
             return as_vector(self.name, value, int(self.kind[7:-1]))
         if self.kind == 'int':
@@ -140,6 +147,8 @@ class Param:
         limits = ''
         if self.low is not None and self.high is not None and self.kind in ('double', 'int'):
             limits = f'{self.low:g} .. {self.high:g}'
+            if self.above_low:
+                limits = f'> {self.low:g}, <= {self.high:g}'
         elif self.choices:
             limits = ', '.join(self.choices)
         cells = [f'`{self.name}`', self.kind, self.shown, limits,
