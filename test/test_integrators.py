@@ -353,3 +353,33 @@ def test_unknown_removed_integrator_and_bad_state_are_refused():
         make_integrator('rk4', MOMENTS, 0.0)
     with pytest.raises(ValueError, match='finite'):
         make_integrator('rk4', MOMENTS, 1e-3, Q0, (np.nan, 0.0, 0.0))
+
+
+def test_our_dop853_tableau_is_scipys_bit_for_bit():
+    """The order-8 tableau is ours (physics/dop853_tableau.py, source cited); scipy's agrees."""
+    from rigid_body_dynamics.physics import dop853_tableau as ours
+    from scipy.integrate._ivp import dop853_coefficients as scipys   # private: test only
+    n = scipys.N_STAGES
+    assert len(ours.A) == len(ours.B) == len(ours.C) == n == 12
+    assert ours.C == tuple(float(c) for c in scipys.C[:n])
+    assert ours.B == tuple(float(b) for b in scipys.B)
+    for i in range(n):
+        assert ours.A[i] == tuple(float(a) for a in scipys.A[i, :i]), i
+    # consistency of the formula itself: rows sum to the nodes, weights to 1
+    for i in range(1, n):
+        assert sum(ours.A[i]) == pytest.approx(ours.C[i], abs=1e-14)
+    assert sum(ours.B) == pytest.approx(1.0, abs=1e-14)
+
+
+def test_a_traceback_through_a_kernel_shows_the_stage_statement():
+    import traceback
+
+    def field(_t, *_q):
+        raise ZeroDivisionError('from the field')
+    try:
+        KERNELS[(8, 'field')]((0.0, 0.0, 0.0, 1.0, 1.0, 1.0), (0.0, 0.0, 0.0, 1.0),
+                              (0.1, 0.2, 0.3), 0.01, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), field)
+    except ZeroDivisionError:
+        text = traceback.format_exc()
+    assert 'File "<rk kernel order 8 field>", line 10, in step' in text
+    assert 'fx, fy, fz = field(t + 0.0 * h, qx0, qy0, qz0, qw0)' in text

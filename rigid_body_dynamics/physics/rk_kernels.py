@@ -12,9 +12,13 @@ generates its class) and compiled once at import. The tableaux:
 - ``RK4``: the classic fourth-order method (4 stages).
 - ``BUTCHER6``: Butcher's 7-stage method of order 6 (rational coefficients;
   J. C. Butcher, Numerical Methods for ODEs, 2nd ed., section 325).
-- ``DOP853``: the 12-stage order-8 formula of Dormand and Prince's DOP853,
-  its coefficients taken from scipy (``scipy.integrate._ivp.dop853_coefficients``),
-  without the error estimator or dense output.
+- ``DOP853``: the 12-stage order-8 formula of Dormand and Prince's DOP853
+  (:mod:`.dop853_tableau`, with its source), without the error estimator or
+  dense output.
+
+Each kernel's source is registered with :mod:`linecache` under the file name
+``<rk kernel ORDER MODE>``, so a traceback through a kernel shows the stage's
+statement.
 
 Each kernel is ``step(inv, q, w, h, tau, tau_world, field=None, t=0.0)`` with
 ``inv`` = (c1, c2, c3, 1/I1, 1/I2, 1/I3), c1 = (I2 - I3) / I1 and cyclic,
@@ -30,8 +34,9 @@ gravity-gradient torque is integrated to the method's order, not held).
 """
 
 from fractions import Fraction as F
+import linecache
 
-from scipy.integrate._ivp import dop853_coefficients as _dop
+from . import dop853_tableau
 
 #: The classic RK4 tableau (A lower triangular rows, b).
 RK4 = (((), (F(1, 2),), (F(0), F(1, 2)), (F(0), F(0), F(1))),
@@ -51,11 +56,7 @@ BUTCHER6 = (
 
 #: DOP853's order-8 tableau (12 stages) as floats, with its nodes c (the float rows of A
 #: sum to them only within round-off).
-DOP853 = (
-    tuple(tuple(float(a) for a in _dop.A[i, :i]) for i in range(_dop.N_STAGES)),
-    tuple(float(b) for b in _dop.B),
-    tuple(float(c) for c in _dop.C[:_dop.N_STAGES]),
-)
+DOP853 = (dop853_tableau.A, dop853_tableau.B, dop853_tableau.C)
 
 _OMEGA = ('wx', 'wy', 'wz')
 _QUAT = ('qx', 'qy', 'qz', 'qw')
@@ -145,15 +146,18 @@ def kernel_source(tableau, mode, name='step'):
     return '\n'.join(lines) + '\n'
 
 
-def compile_kernel(tableau, mode):
-    """Compile :func:`kernel_source` into a function."""
+def compile_kernel(tableau, mode, label=''):
+    """Compile :func:`kernel_source` into a function; its source goes to linecache."""
+    source = kernel_source(tableau, mode)
+    filename = f'<rk kernel {label} {mode}>'
+    # (size, mtime None: never checked against a file, lines, name), as for code without a file
+    linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
     namespace = {}
-    code = compile(kernel_source(tableau, mode), f'<rk kernel {mode}>', 'exec')
-    exec(code, namespace)  # noqa: S102 (source generated above from the tableau only)
+    exec(compile(source, filename, 'exec'), namespace)  # noqa: S102 (generated from a tableau)
     return namespace['step']
 
 
 #: Kernels by (order, mode).
-KERNELS = {(order, mode): compile_kernel(tableau, mode)
+KERNELS = {(order, mode): compile_kernel(tableau, mode, f'order {order}')
            for order, tableau in ((4, RK4), (6, BUTCHER6), (8, DOP853))
            for mode in ('free', 'body', 'world', 'field')}
