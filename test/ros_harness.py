@@ -14,6 +14,7 @@ import time
 from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rigid_body_dynamics.physics import FreeRigidBody, quaternions
 from rigid_body_dynamics.ros.client import interrupt, RosClient, start_node  # noqa: F401
@@ -208,6 +209,21 @@ class Probe(RosClient):
             while not heard() and time.monotonic() < until:
                 self.executor.spin_once(timeout_sec=0.02)
         return sent
+
+    def endpoints(self, kind, node, namespace='/'):
+        """
+        Return {name: type} of a node's publishers, subscriptions or services on the graph.
+
+        ``kind``: 'pub', 'sub' or 'srv'. Empty until the node is discovered (rclpy
+        raises for a node it does not know yet).
+        """
+        call = {'pub': self.node.get_publisher_names_and_types_by_node,
+                'sub': self.node.get_subscriber_names_and_types_by_node,
+                'srv': self.node.get_service_names_and_types_by_node}[kind]
+        try:
+            return {name: types[0] for name, types in call(node, namespace)}
+        except _rclpy.NodeNameNonExistentError:
+            return {}
 
     def call(self, srv_type, name, request, timeout=20.0):
         """Call a service and return its response."""

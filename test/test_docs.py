@@ -126,24 +126,14 @@ def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs
     tables = {'attitude_simulator': simulator.PARAMETERS, 'attitude_analyzer': analyzer.PARAMETERS,
               'poinsot_visualizer': poinsot.PARAMETERS,
               'attitude_controller': controller.PARAMETERS}
-    graph = probe.node
-    calls = {'pub': graph.get_publisher_names_and_types_by_node,
-             'sub': graph.get_subscriber_names_and_types_by_node,
-             'srv': graph.get_service_names_and_types_by_node}
     for node, interfaces in NODES.items():
         want = interfaces.resolved('/')          # publish_clock on, every other default
 
         def have():
-            out = {}
-            for kind, call in calls.items():
-                found = {}
-                names = (node, f'_{node}_intake') if kind == 'sub' else (node,)
-                for name in names:        # the take-based subscriptions are on a helper node
-                    try:
-                        found.update(dict(call(name, '/')))
-                    except Exception:                         # not (yet) on the graph
-                        pass
-                out[kind] = {t: types[0] for t, types in found.items()}
+            out = {kind: probe.endpoints(kind, node) for kind in ('pub', 'srv')}
+            # the take-based subscriptions are on a hidden helper node
+            out['sub'] = {**probe.endpoints('sub', node),
+                          **probe.endpoints('sub', f'_{node}_intake')}
             return out
         try:
             probe.spin_until(lambda: have() == want, 30.0, f'the graph of {node} as documented')

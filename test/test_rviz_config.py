@@ -47,9 +47,8 @@ def test_topics_frames_and_namespaces_are_what_the_nodes_publish(launch, probe):
     probe.spin_until(lambda: odom and len(arrays) >= 3, 30.0, 'odom and 3 marker arrays')
     published = {}
     for node in ('attitude_simulator', 'poinsot_visualizer'):
-        probe.spin_until(lambda: probe.node.get_publisher_names_and_types_by_node(node, '/'),
-                         10.0, f'the publishers of {node}')
-        published.update(probe.node.get_publisher_names_and_types_by_node(node, '/'))
+        probe.spin_until(lambda: probe.endpoints('pub', node), 20.0, f'the publishers of {node}')
+        published.update(probe.endpoints('pub', node))
 
     manager = _config()['Visualization Manager']
     world = odom[-1].header.frame_id
@@ -65,7 +64,7 @@ def test_topics_frames_and_namespaces_are_what_the_nodes_publish(launch, probe):
             continue
         topic = '/' + display['Topic']['Value']      # relative: the nodes' namespace, here /
         assert topic in published, f'{display["Name"]}: nobody publishes {topic}'
-        assert published[topic] == [DISPLAY_TYPES[display['Class']]]
+        assert published[topic] == DISPLAY_TYPES[display['Class']]
         if 'Namespaces' in display:
             assert set(display['Namespaces']) == namespaces
         shown += 1
