@@ -29,7 +29,8 @@ import numpy as np
 
 from . import optional, report_page
 from .bags import BagError, BagWriter, INERTIA, ODOMETRY, read_trajectory, WRENCH
-from .physics import estimators, INTEGRATORS, momentum_sphere, presets, quaternions, simulate
+from .physics import estimators, INTEGRATORS, momentum_sphere, poinsot, presets, quaternions
+from .physics import simulate
 from .physics.analysis import analyse, Trajectory
 from .physics.sensors import allan_deviation, GyroErrors, GyroModel
 
@@ -221,23 +222,18 @@ def make_report(run, out_dir, gyro=None):
     ax.legend(loc='best')
     figures['omega'] = (_save(fig, out_dir, 'omega.png'), curves)
 
-    energy = 0.5 * np.sum(moments * w * w, axis=1)
-    two_t = 2.0 * energy[0]
+    geometry = poinsot.construction(moments, q[0], w[0])
     fig, ax = _figure('Polhode: omega on the inertia ellipsoid omega.I.omega = 2T (body frame)',
                       'omega_1 (rad/s)', 'omega_2 (rad/s)', projection='3d')
-    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0, np.pi, 20))
-    a = np.sqrt(two_t / moments)
-    ax.plot_wireframe(a[0] * np.cos(u) * np.sin(v), a[1] * np.sin(u) * np.sin(v),
-                      a[2] * np.cos(v), color='0.8', linewidth=0.5)
+    ax.plot_wireframe(*poinsot.ellipsoid_surface(geometry.semi_axes, 40), color='0.8',
+                      linewidth=0.5)
     ax.plot(w[:, 0], w[:, 1], w[:, 2], color='tab:red', label='polhode')
     ax.set_zlabel('omega_3 (rad/s)')
     ax.legend(loc='upper left')
     figures['polhode'] = (_save(fig, out_dir, 'polhode.png'), {'polhode': w})
 
     w_world = quaternions.rotate(q, w)
-    l_world = quaternions.rotate(q, moments * w)
-    normal = l_world[0] / np.linalg.norm(l_world[0])
-    e1, e2, _ = estimators.basis_perpendicular(normal)
+    e1, e2, _ = estimators.basis_perpendicular(geometry.normal)
     plane = np.stack([w_world @ e1, w_world @ e2], axis=1)
     fig, ax = _figure('Herpolhode: omega in the invariant plane (world frame, normal L)',
                       'along e_u (rad/s)', 'along e_v (rad/s)')

@@ -12,11 +12,10 @@ marker at the frame's time, with a slider and play button.
 """
 
 import os
-import shutil
 
 import numpy as np
 
-from .physics import estimators, momentum_sphere, quaternions
+from .physics import estimators, momentum_sphere, poinsot, quaternions
 from .physics.inertia import equivalent_box
 
 #: Frames of the animation (evenly spaced samples of the run).
@@ -32,11 +31,6 @@ def box_vertices(moments):
     a, b, c = equivalent_box(moments) / 2.0
     return np.array([[-a, -b, -c], [a, -b, -c], [a, b, -c], [-a, b, -c],
                      [-a, -b, c], [a, -b, c], [a, b, c], [-a, b, c]])
-
-
-def _ellipsoid(semi, n=30):
-    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, n), np.linspace(0, np.pi, n // 2))
-    return semi[0] * np.cos(u) * np.sin(v), semi[1] * np.sin(u) * np.sin(v), semi[2] * np.cos(v)
 
 
 def _line(points, name, color, width=4, dash=None):
@@ -58,21 +52,19 @@ def views(moments, t, q, w):
     stride = max(1, -(-len(t) // MAX_POINTS))
     t, q, w = t[::stride], q[::stride], w[::stride]
     l_body = moments * w
-    two_t = float(np.sum(moments * w[0] * w[0]))
+    geometry = poinsot.construction(moments, q[0], w[0])
     out = {}
     fig = go.Figure([go.Surface(x=x, y=y, z=z, opacity=0.25, showscale=False,
                                 colorscale='Greys', name='inertia ellipsoid')
-                     for x, y, z in [_ellipsoid(np.sqrt(two_t / moments))]])
+                     for x, y, z in [poinsot.ellipsoid_surface(geometry.semi_axes)]])
     fig.add_trace(_line(w, 'polhode (omega, body frame)', 'crimson'))
     fig.update_layout(title='Polhode on the inertia ellipsoid omega.I.omega = 2T (body frame)',
                       scene_aspectmode='data')
     out['polhode'] = fig
 
     w_world = quaternions.rotate(q, w)
-    l_world = quaternions.rotate(q, l_body)
-    normal = l_world[0] / np.linalg.norm(l_world[0])
+    normal, d = geometry.normal, geometry.distance
     e1, e2, _ = estimators.basis_perpendicular(normal)
-    d = two_t / np.linalg.norm(l_world[0])
     r = 1.2 * float(np.max(np.linalg.norm(w_world - d * normal, axis=1))) + 1e-12
     s, u = np.meshgrid(np.linspace(-r, r, 2), np.linspace(-r, r, 2))
     plane = d * normal[:, None, None] + e1[:, None, None] * s + e2[:, None, None] * u
@@ -84,7 +76,7 @@ def views(moments, t, q, w):
     out['herpolhode'] = fig
 
     l0 = float(np.linalg.norm(l_body[0]))
-    x, y, z = _ellipsoid(np.array([l0, l0, l0]))
+    x, y, z = poinsot.ellipsoid_surface((l0, l0, l0))
     fig = go.Figure([go.Surface(x=x, y=y, z=z, opacity=0.15, showscale=False,
                                 colorscale='Greys', name='|L| = |L0|')])
     family = momentum_sphere.curve_family(moments, l0)
@@ -98,7 +90,8 @@ def views(moments, t, q, w):
                       scene_aspectmode='data')
     out['momentum sphere'] = fig
 
-    out['tumbling body'] = _animation(moments, t, q, w, l_world, make_subplots, go)
+    out['tumbling body'] = _animation(moments, t, q, w, quaternions.rotate(q, l_body),
+                                      make_subplots, go)
     return out
 
 
@@ -159,9 +152,9 @@ def _animation(moments, t, q, w, l_world, make_subplots, go):
 
 def write(out_dir, figures):
     """Write plotly.min.js beside the page; return the HTML of the figures' divs."""
-    import plotly
-    source = os.path.join(os.path.dirname(plotly.__file__), 'package_data', 'plotly.min.js')
-    shutil.copyfile(source, os.path.join(out_dir, 'plotly.min.js'))
+    from plotly.offline import get_plotlyjs
+    with open(os.path.join(out_dir, 'plotly.min.js'), 'w', encoding='utf-8') as f:
+        f.write(get_plotlyjs())
     parts = []
     for name, fig in figures.items():
         fig.update_layout(height=650 if name == 'tumbling body' else 550)

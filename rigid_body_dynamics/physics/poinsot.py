@@ -54,6 +54,18 @@ def construction(moments, q, omega):
                                distance=2.0 * energy / g)
 
 
+def ellipsoid_surface(semi_axes, n=30):
+    """
+    Mesh (x, y, z), each (n // 2, n), of the ellipsoid with these semi-axes along x, y, z.
+
+    For drawing: the inertia ellipsoid (``construction(...).semi_axes``, rad/s, body
+    frame) or a sphere of radius |L| (three equal semi-axes).
+    """
+    a = np.asarray(semi_axes, dtype=float)
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, n), np.linspace(0, np.pi, n // 2))
+    return a[0] * np.cos(u) * np.sin(v), a[1] * np.sin(u) * np.sin(v), a[2] * np.cos(v)
+
+
 def plane_orientation(normal):
     """Quaternion (x, y, z, w) turning +z onto the unit vector ``normal`` (minimal rotation)."""
     n = np.asarray(normal, dtype=float)
