@@ -72,18 +72,18 @@ class Disturbances:
 
 class ImuSample(NamedTuple):
     """
-    One gyro sample, in the user's body frame.
+    One gyro sample, in the user's body frame (the field names say so).
 
-    ``stamp_ns``, the reported attitude ``q`` (x, y, z, w, body -> world, with
-    orientation noise), the measured rate ``omega`` (rad/s) and the true
-    ``bias`` (rad/s) in it, and the gyro's ``rate_variance`` (rad/s)^2 and
+    ``stamp_ns``, the reported attitude ``q_body`` (x, y, z, w, body -> world, with
+    orientation noise), the measured rate ``omega_body`` (rad/s) and the true
+    ``bias_body`` (rad/s), and the gyro's ``rate_variance`` (rad/s)^2 and
     ``orientation_variance`` (rad^2) per axis.
     """
 
     stamp_ns: int
-    q: tuple
-    omega: tuple
-    bias: tuple
+    q_body: tuple
+    omega_body: tuple
+    bias_body: tuple
     rate_variance: float
     orientation_variance: float
 
@@ -92,18 +92,19 @@ class Snapshot(NamedTuple):
     """
     What one publish tick needs, taken under the lock.
 
-    ``stamp_ns`` (int ns: start + simulated time), ``steps``, principal-frame
-    ``q`` (x, y, z, w) and ``omega`` (rad/s), the principal-frame ``torque``
-    (N m) integrated over the step that ended here, and the ``inertia``. A
-    NamedTuple: one is made at every publish tick of every body, where a frozen
-    dataclass cost 2-3 us to build.
+    ``stamp_ns`` (int ns: start + simulated time), ``steps``, the state in the
+    principal frame of the inertia (the field names say so; ``inertia`` turns it
+    into the user's body frame): ``q_principal`` (x, y, z, w, principal -> world),
+    ``omega_principal`` (rad/s), the ``torque_principal`` (N m) integrated over the
+    step that ended here, and the ``inertia``. A NamedTuple: one is made at every
+    publish tick of every body, where a frozen dataclass cost 2-3 us to build.
     """
 
     stamp_ns: int
     steps: int
-    q: tuple
-    omega: tuple
-    torque: tuple
+    q_principal: tuple
+    omega_principal: tuple
+    torque_principal: tuple
     inertia: object
     odom_only: bool = False    # lockstep's tick state between publish ticks: odom (and clock, TF)
 

@@ -123,7 +123,7 @@ class StatePublisher:
             self.publish_imu(snapshot)
             return
         inertia = snapshot.inertia
-        q_b, w_b = snapshot.q, snapshot.omega
+        q_b, w_b = snapshot.q_principal, snapshot.omega_principal
         if not inertia.is_principal_frame:
             q_b = inertia.attitude_to_body(np.array(q_b))
             w_b = inertia.to_body(np.array(w_b))
@@ -142,16 +142,16 @@ class StatePublisher:
         if self._orientation is not None:
             self._orientation.publish(self._orientation_bytes.pack(stamp, q_b))
         if self._vectors:
-            m_p = tuple(i * w for i, w in zip(inertia.moments, snapshot.omega))
+            m_p = tuple(i * w for i, w in zip(inertia.moments, snapshot.omega_principal))
             vectors = {'omega': w_b,
-                       'l_world': quaternions.rotate_components(snapshot.q, m_p),
+                       'l_world': quaternions.rotate_components(snapshot.q_principal, m_p),
                        'l_body': m_p if inertia.is_principal_frame else
                        inertia.to_body(np.array(m_p))}
             for pub, kind, packed in self._vectors:
                 pub.publish(packed.pack(stamp, vectors[kind]))
         if self._torque is not None:
-            torque = snapshot.torque if inertia.is_principal_frame else \
-                inertia.to_body(np.array(snapshot.torque))
+            torque = snapshot.torque_principal if inertia.is_principal_frame else \
+                inertia.to_body(np.array(snapshot.torque_principal))
             self._torque.publish(self._torque_bytes.pack(stamp, torque))
 
     @property
@@ -178,9 +178,9 @@ class StatePublisher:
             return
         rate, orientation = (sample.rate_variance,) * 3, (sample.orientation_variance,) * 3
         self._imu.publish(self._imu_bytes.pack(
-            sample.stamp_ns, sample.q, sample.omega,
+            sample.stamp_ns, sample.q_body, sample.omega_body,
             _diagonal(orientation), _diagonal(rate)))
-        self._imu_bias.publish(self._bias_bytes.pack(sample.stamp_ns, sample.bias))
+        self._imu_bias.publish(self._bias_bytes.pack(sample.stamp_ns, sample.bias_body))
 
     def publish_inertia(self, inertia, stamp_ns):
         """Publish the latched inertia tensor (kg m^2, body frame; the mass is not modelled)."""
