@@ -181,9 +181,17 @@ class BodySimulation:
     axis; 0 = no limit), ``publish_every`` (steps per publish tick), ``imu_every``
     (steps per gyro sample, 0 = none), ``gyro`` (GyroErrors; None = perfect) and
     its ``seed``, ``start_ns`` (stamp of simulated time 0), ``disturbances``
-    (:class:`Disturbances`; None = none). ``lock`` guards every change;
-    the methods take it themselves. ``notes`` collects what a node should
+    (:class:`Disturbances`; None = none). ``notes`` collects what a node should
     log (the watchdog's timeouts), drained with :meth:`take_notes`.
+
+    ``lock`` (re-entrant) guards the state. The methods other threads call take it
+    themselves: :meth:`reset`, :meth:`set_paused`, :meth:`configure`,
+    :meth:`command`, :meth:`batch`, :meth:`reject`, :meth:`take_notes`,
+    :meth:`health`. The stepping methods are called by the one thread that
+    holds it for a whole wake (the engine's Pace or Lockstep) and say "call
+    under ``lock``": :meth:`advance`, :meth:`advance_free`, :meth:`torque_now`,
+    :meth:`first_items`, :meth:`imu_sample`, :meth:`snapshot`,
+    :meth:`invariants`, :meth:`body_state`.
     """
 
     def __init__(self, inertia, integrator, rate, initial, torque_timeout=0.5, max_torque=0.0,
@@ -244,12 +252,16 @@ class BodySimulation:
         self._base_stale = False
 
     def invariants(self):
-        """(T in J, L_w in kg m^2/s, world frame) of the current state."""
+        """(T in J, L_w in kg m^2/s, world frame) of the current state (call under ``lock``)."""
         s = self.stepper
         return s.kinetic_energy, s.angular_momentum_world
 
     def body_state(self):
-        """(q (x, y, z, w), omega (rad/s)) of the user's body frame, as sequences of floats."""
+        """
+        (q (x, y, z, w), omega (rad/s)) in the user's body frame, as float sequences.
+
+        Call under ``lock``.
+        """
         s, body = self.stepper, self.inertia
         if body.is_principal_frame:
             return s.q, s.omega
@@ -369,8 +381,10 @@ class BodySimulation:
         """
         Torque for the next step: (principal-frame part, world-frame part or None).
 
-        Zero once ``torque_timeout`` has passed since the command arrived (a
-        note says so once per timeout).
+        Also the watchdog: zero once ``torque_timeout`` has passed since the
+        command arrived, and a note says so once per timeout; so it is called
+        for that alone where a step does not ask for the torque (call under
+        ``lock``).
         """
         cmd = self.command_held
         if cmd is None:
