@@ -16,8 +16,29 @@ Tested against rosbags' deserialiser (test/test_bags.py).
 import numpy as np
 
 _HEADER = 4          # encapsulation bytes before the payload
-_ODOMETRY_TAIL = 680   # pose (7 + 36 f64) and twist (6 + 36 f64) after the child frame id
-_WRENCH_TAIL = 48      # force and torque, 6 f64
+
+
+def _layout(*fields):
+    """
+    Offsets of consecutive float64 fields after the last string: ({name: offset}, size).
+
+    ``fields`` are (name, number of float64) in the message definition's order;
+    all are 8-aligned, so each starts where the one before ends.
+    """
+    offsets, at = {}, 0
+    for name, count in fields:
+        offsets[name] = at
+        at += 8 * count
+    return offsets, at
+
+
+#: nav_msgs/Odometry after child_frame_id: pose (geometry_msgs/PoseWithCovariance:
+#: Point, Quaternion, float64[36]) then twist (TwistWithCovariance: linear, angular, float64[36]).
+_ODOMETRY, _ODOMETRY_TAIL = _layout(('position', 3), ('orientation', 4),
+                                    ('pose_covariance', 36), ('linear', 3), ('angular', 3),
+                                    ('twist_covariance', 36))
+#: geometry_msgs/WrenchStamped after header.frame_id: Wrench (force, torque).
+_WRENCH, _WRENCH_TAIL = _layout(('force', 3), ('torque', 3))
 
 
 class NotUniform(ValueError):
@@ -83,7 +104,8 @@ def odometry_arrays(raws):
     base = _align(end, 8)
     if _HEADER + base + _ODOMETRY_TAIL > buf.shape[1]:
         raise NotUniform('truncated Odometry')
-    return (_stamps(buf), _field(buf, base + 24, 4), _field(buf, base + 368, 3), world, child)
+    return (_stamps(buf), _field(buf, base + _ODOMETRY['orientation'], 4),
+            _field(buf, base + _ODOMETRY['angular'], 3), world, child)
 
 
 def wrench_arrays(raws, force=False):
@@ -98,6 +120,7 @@ def wrench_arrays(raws, force=False):
     base = _align(end, 8)
     if _HEADER + base + _WRENCH_TAIL > buf.shape[1]:
         raise NotUniform('truncated WrenchStamped')
+    torque = _field(buf, base + _WRENCH['torque'], 3)
     if force:
-        return _stamps(buf), _field(buf, base + 24, 3), frame, _field(buf, base, 3)
-    return _stamps(buf), _field(buf, base + 24, 3), frame
+        return _stamps(buf), torque, frame, _field(buf, base + _WRENCH['force'], 3)
+    return _stamps(buf), torque, frame

@@ -128,3 +128,46 @@ def test_fields_that_cannot_be_refilled_are_refused():
         Prepacked(_odometry(('world', 'body')), ('header',))
     with pytest.raises(AttributeError):
         Prepacked(_odometry(('world', 'body')), ('pose.pose.nothing',))
+
+
+def test_cdr_field_offsets_are_where_rclpy_serialises_the_fields():
+    """cdr.py's layouts (from the message definitions) agree with sentinel serialisations."""
+    import struct
+    from nav_msgs.msg import Odometry
+    from rclpy.serialization import serialize_message
+    from rigid_body_dynamics import cdr
+
+    def base_after(*frames):
+        """Payload offset after the header stamp and the frame id strings, 8-aligned."""
+        at = 8
+        for frame in frames:
+            at = (at + 3) // 4 * 4 + 4 + len(frame) + 1
+        return (at + 7) // 8 * 8
+    odom = Odometry()
+    odom.header.frame_id, odom.child_frame_id = 'odom', 'base_link'
+    values = {}
+    for k, (name, path, count) in enumerate((
+            ('position', 'pose.pose.position', 3), ('orientation', 'pose.pose.orientation', 4),
+            ('linear', 'twist.twist.linear', 3), ('angular', 'twist.twist.angular', 3))):
+        target = odom
+        for part in path.split('.'):
+            target = getattr(target, part)
+        sentinel = [1000.0 * (k + 1) + i + 0.25 for i in range(count)]
+        for attr, value in zip('xyzw', sentinel):
+            setattr(target, attr, value)
+        values[name] = sentinel
+    odom.pose.covariance[0] = odom.twist.covariance[0] = 7.125
+    raw = serialize_message(odom)
+    base = base_after('odom', 'base_link')
+    for name, sentinel in values.items():
+        at = raw.find(struct.pack(f'<{len(sentinel)}d', *sentinel)) - cdr._HEADER
+        assert at == base + cdr._ODOMETRY[name], name
+    assert len(raw) - cdr._HEADER == base + cdr._ODOMETRY_TAIL
+    wrench = WrenchStamped()
+    wrench.header.frame_id = 'base_link'
+    wrench.wrench.force.x, wrench.wrench.torque.x = 3.5, 4.5
+    raw = serialize_message(wrench)
+    base = base_after('base_link')
+    for name, value in (('force', 3.5), ('torque', 4.5)):
+        assert raw.find(struct.pack('<d', value)) - cdr._HEADER == base + cdr._WRENCH[name]
+    assert len(raw) - cdr._HEADER == base + cdr._WRENCH_TAIL
