@@ -21,17 +21,6 @@ from .bags import BagError, read_trajectory
 from .physics.analysis import analyse, Tolerances
 
 
-def _tolerance(text):
-    """Parse a tolerance: a finite number > 0 (0 would switch its check off)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
-    if not 0.0 < value < float('inf'):
-        raise argparse.ArgumentTypeError(f'must be a finite number > 0, got {text}')
-    return value
-
-
 def main(argv=None):
     """Console entry point."""
     parser = argparse.ArgumentParser(
@@ -50,11 +39,16 @@ def main(argv=None):
                                 ('momentum-tolerance', 1e-6, 'drift of |L| and L direction'),
                                 ('balance-tolerance', 1e-2, 'balance residual under torque'),
                                 ('rate-tolerance', 1e-6, 'measured against predicted rates')):
-        parser.add_argument(f'--{name}', type=_tolerance, default=default,
+        parser.add_argument(f'--{name}', type=float, default=default,
                             help=f'{text} (default {default:g})')
     args = parser.parse_args(argv)
     if args.inertia is not None and len(args.inertia) not in (3, 6):
         parser.error('--inertia takes 3 moments or 6 tensor elements')
+    try:
+        tolerances = Tolerances(energy=args.energy_tolerance, momentum=args.momentum_tolerance,
+                                balance=args.balance_tolerance, rate=args.rate_tolerance)
+    except ValueError as err:             # a tolerance <= 0: the reason, one line
+        parser.error(str(err))
     try:
         optional.require('rosbags')
         traj, info = read_trajectory(args.path, args.odom_topic, args.torque_topic,
@@ -62,8 +56,6 @@ def main(argv=None):
     except (BagError, optional.MissingDependency) as err:
         print(f'rigid_body_analyze: {err}', file=sys.stderr)
         return 2
-    tolerances = Tolerances(energy=args.energy_tolerance, momentum=args.momentum_tolerance,
-                            balance=args.balance_tolerance, rate=args.rate_tolerance)
     found = analyse(traj, tolerances=tolerances)
     dropped = {k: v for k, v in info.dropped.items() if v}
     if args.json:

@@ -368,7 +368,7 @@ def main(argv=None):
     parser.add_argument('--dt', type=float, default=1e-3, help='step (s), offline')
     parser.add_argument('--out', default='report', help='output folder (default ./report)')
     noise = parser.add_argument_group(
-        'simulated gyro (offline; adds an Allan-deviation figure; README "Sensor noise")')
+        'simulated gyro (offline; adds an Allan-deviation figure; the manual, "A noisy IMU")')
     noise.add_argument('--gyro-noise-density', type=float, default=0.0, metavar='N',
                        help='white rate noise N (rad/s/sqrt(Hz))')
     noise.add_argument('--gyro-bias-random-walk', type=float, default=0.0, metavar='K',

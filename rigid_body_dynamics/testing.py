@@ -15,8 +15,8 @@ and rclpy is not imported, otherwise):
   state and returns a :class:`SimulatorHandle`; every simulator and every
   process started through a handle is stopped at the end of the test.
 
-A complete test of a controller is in README ("Your controller in a test"),
-and the suite runs it as it stands there.
+A complete test of a controller is in the manual's lockstep tutorial
+(doc/examples/test_detumble.py), and the suite runs it as it stands there.
 """
 
 import os

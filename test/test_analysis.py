@@ -191,4 +191,4 @@ def test_rigid_body_analyze_refuses_a_zero_tolerance(capsys):
     with pytest.raises(SystemExit) as stop:
         analyze.main(['any.mcap', '--rate-tolerance', '0'])
     assert stop.value.code == 2
-    assert '--rate-tolerance: must be a finite number > 0, got 0' in capsys.readouterr().err
+    assert 'the rate tolerance must be a finite number > 0, got 0.0' in capsys.readouterr().err

@@ -142,7 +142,7 @@ class Pace:
 
     def restart(self):
         """After a reset of the body: as :meth:`begin`."""
-        Pace.begin(self)
+        self.begin()
 
     def set_rtf(self, rtf):
         """Change the real-time factor (re-anchors)."""

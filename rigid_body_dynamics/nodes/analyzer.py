@@ -75,7 +75,7 @@ def _inertia(raw):
         raise ConfigurationError(f'inertia: {err}') from None
 
 
-#: The parameters of attitude_analyzer (README's list is made from this; test_config checks).
+#: The parameters of attitude_analyzer (the manual's table is made from this; test_docs checks).
 PARAMETERS = ParameterTable([
     Param('inertia', 'double[3|6]', None, 'unset',
           'Principal moments [I1, I2, I3] (kg m^2) of the body in its odom child frame, or 6 '

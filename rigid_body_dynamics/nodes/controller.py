@@ -47,7 +47,7 @@ def _target(value):
     return tuple(c / norm for c in q)
 
 
-#: The parameters of attitude_controller (README's list is made from this).
+#: The parameters of attitude_controller (the manual's table is made from this; test_docs checks).
 PARAMETERS = ParameterTable([
     Param('mode', 'string', 'slew', '`slew`',
           'slew: quaternion PD to target_orientation; detumble: rate damping only.',

@@ -77,7 +77,7 @@ class Fleet:
             self._destroy()
             raise
         self._untangle_tf()
-        self.context = self.nodes[0].context     # one context, shared by every body
+        self.context = self.nodes[0].context     # the first participant's: rclpy.init's
         self._logger.info(f'{len(names)} bodies in this process, one integration thread, '
                           f'{1 + len(self._contexts)} DDS participants')
 

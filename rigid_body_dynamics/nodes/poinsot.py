@@ -60,7 +60,7 @@ def _trace_length(value):
     return value
 
 
-#: The parameters of poinsot_visualizer (README's list is made from this; test_config checks).
+#: The parameters of poinsot_visualizer (the manual's table is made from this; test_docs checks).
 PARAMETERS = ParameterTable([
     Param('scale', 'double', 1.0, '1.0 m per rad/s',
           'Marker length per rad/s of angular velocity (m per rad/s).', low=1e-12, high=1e12),

@@ -1,8 +1,8 @@
 """
 attitude_simulator: integrates Euler's equations and publishes the attitude state.
 
-Topics, frames and parameters are listed in the README (the parameter list is
-made from ``PARAMETERS`` in :mod:`.simulator_parameters`).
+Topics, frames and parameters are listed in the manual's node page (made from
+:mod:`.interfaces` and ``PARAMETERS`` in :mod:`.simulator_parameters`).
 The node is thin: it keeps the parameters, the torque subscription, the
 services and the diagnostics; the body is an engine
 :class:`~rigid_body_dynamics.engine.body.BodySimulation` (ROS-free), paced by

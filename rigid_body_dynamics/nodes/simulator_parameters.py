@@ -1,8 +1,8 @@
 """
 The parameter table of attitude_simulator: names, defaults, units, ranges, checks.
 
-Declaration, validation and the README's parameter list are all made from
-``PARAMETERS`` (test_config checks the README against it); the converters and
+Declaration, validation and the manual's parameter table are all made from
+``PARAMETERS`` (test_docs checks the manual against it); the converters and
 cross-checks below give every refusal its reason.
 """
 
@@ -105,7 +105,7 @@ def _publish_rate(values, out):
                                  f'got {out["publish_rate"]:g}')
 
 
-#: The parameters of attitude_simulator (README's list is made from this; test_config checks).
+#: The parameters of attitude_simulator (the manual's table is made from this; test_docs checks).
 PARAMETERS = ParameterTable([
     Param('preset', 'string', presets.DEFAULT, f'`{presets.DEFAULT}`',
           'Named body from physics/presets.py; its values are the defaults of the parameters '

@@ -146,13 +146,13 @@ class Tolerances:
     min_samples: int = 20
 
     def __post_init__(self):
-        """Refuse a tolerance that is not a positive number: 0 meant 'strict' and passed all."""
+        """Refuse a tolerance that is not a positive number: 0 switched its check off."""
         for name in ('energy', 'momentum', 'balance', 'rate', 'growth'):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) \
                     or not math.isfinite(value) or value <= 0.0:
-                raise ValueError(f'the {name} tolerance must be a finite number > 0 (a '
-                                 f'tolerance of 0 would pass nothing), got {value!r}')
+                raise ValueError(f'the {name} tolerance must be a finite number > 0, got '
+                                 f'{value!r}')
         if isinstance(self.min_samples, bool) or not isinstance(self.min_samples, int) \
                 or self.min_samples < 2:
             raise ValueError(f'min_samples must be an integer >= 2, got {self.min_samples!r}')

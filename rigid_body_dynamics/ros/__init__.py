@@ -2,7 +2,7 @@
 ROS plumbing shared by the nodes and tools: helpers that take a node, no node of their own.
 
 :mod:`.parameters` (one declarative table per node: declaration, validation,
-README list), :mod:`.state_publisher` (a body's state topics from an engine
+the manual's table), :mod:`.state_publisher` (a body's state topics from an engine
 snapshot, TF and IMU included), :mod:`.intake` (taking messages without an
 executor callback each), :mod:`.conversions` (messages <-> numpy),
 :mod:`.diagnostics` (the analysis' findings as /diagnostics),

@@ -3,9 +3,10 @@ Findings of the analysis -> diagnostic_msgs/DiagnosticStatus (REP 107) for attit
 
 Status names are ``<node>: conservation``, ``<node>: precession`` and
 ``<node>: stability``; the keys are an interface users parse, listed in the
-README. A measured quantity gives three keys, ``<label>, measured (<unit>)``,
-``<label>, theory (<unit>)`` and ``<label> error (rel.)``; one that is not
-available gives ``<label>, measured (<unit>)`` = ``not available: <why>``.
+manual's attitude_analyzer page. A measured quantity gives three keys,
+``<label>, measured (<unit>)``, ``<label>, theory (<unit>)`` and
+``<label> error (rel.)``; one that is not available gives
+``<label>, measured (<unit>)`` = ``not available: <why>``.
 ``unavailable`` findings are level OK with the reason as the message.
 """
 

@@ -79,15 +79,15 @@ def check_change(logger, validate, values):
 @dataclass(frozen=True)
 class Param:
     """
-    One node parameter: declaration, validation and its README line from one place.
+    One node parameter: declaration, validation and its row in the manual from one place.
 
     ``kind``: 'double', 'double[N]', 'double[3|6]', 'int', 'bool' or 'string'.
     ``default``: the value, or a callable of the node returning it (it may
     read parameters declared before it, e.g. the preset); None for an
     optional parameter that is unset.
-    ``shown``: the default as the README shows it (e.g. '1000.0 Hz', 'preset').
+    ``shown``: the default as the manual shows it (e.g. '1000.0 Hz', 'preset').
     ``text``: what it means, with units; the descriptor's description and the
-    README's text. ``low`` / ``high``: the inclusive range (rclpy enforces it
+    manual's text. ``low`` / ``high``: the inclusive range (rclpy enforces it
     for numbers); ``above_low``: ``low`` itself is refused too (a tolerance of 0
     would switch its check off; rclpy's ranges are inclusive, so the node
     refuses it with the reason); ``choices``: allowed strings; ``convert(value)``: a custom
