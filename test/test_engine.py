@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 import pytest
-from rigid_body_dynamics.engine import BodySimulation, Pace
+from rigid_body_dynamics.engine import BodySimulation, Pace, TorqueCommands
 from rigid_body_dynamics.engine import pacer
 from rigid_body_dynamics.physics import FreeRigidBody, Inertia, make_integrator, quaternions
 
@@ -81,10 +81,10 @@ def test_watchdog_times_out_the_command_once_and_says_so():
 def test_clipping_rejection_and_forces_are_counted_and_leave_the_state():
     body = make_body(max_torque=0.2)
     before = (body.stepper.q, body.stepper.omega)
-    assert body.command((math.nan, 0.0, 0.0), False, 0) == ['rejected_non_finite']
+    assert body.command((math.nan, 0.0, 0.0), False, 0) == {'rejected_non_finite'}
     assert body.command_held is None and (body.stepper.q, body.stepper.omega) == before
-    assert body.command((0.5, -0.1, -3.0), False, 0, force=(1.0, 0.0, 0.0)) == [
-        'clipped', 'force_ignored', 'accepted']
+    assert body.command((0.5, -0.1, -3.0), False, 0, force=(1.0, 0.0, 0.0)) == {
+        'clipped', 'force_ignored', 'accepted'}
     assert body.command_held.vector == (0.2, -0.1, -0.2)
     body.reject('rejected_frame')
     assert body.health()['counts'] == {'accepted': 1, 'rejected_non_finite': 1,
@@ -266,17 +266,11 @@ def test_commands_act_from_the_step_they_came_in_as_if_stepped_every_deadline():
     paced, ref = make_body(**options), make_body(**options)
     pending = list(zip(times.tolist(), vectors))
 
-    def take():
+    def inbox():
         came = [p for p in pending if p[0] <= clock.ns]
         del pending[:len(came)]
-        if not came:
-            return None
-
-        def apply(start, stop, at_ns):
-            for _t, v in came[start:stop]:
-                paced.command(v, False, at_ns)
-        return [c[0] for c in came], apply
-    pace = Pace(paced, 1.0, clock=clock, perf=clock.perf, take_commands=take)
+        return [TorqueCommands([c[0] for c in came], [c[1] for c in came])] if came else []
+    pace = Pace(paced, 1.0, clock=clock, perf=clock.perf, inbox=inbox)
     out, ref_out = [], []
     while clock.ns < t0 + int(0.7e9):
         wait = pace.due(out)
@@ -345,17 +339,20 @@ def test_lockstep_waits_for_each_tick_and_holds_from_it():
     clock.advance(int(1.5e9))
     lock.due(outbox)
     assert [s.stamp_ns for s in outbox] == [0]                # t_0 again for a late controller
-    assert lock.command((0.1, 0.0, 0.0), False, clock(), stamp_ns=0) == ['accepted']
-    assert lock.arrived.is_set()
+    lock.mailbox.put(TorqueCommands.one((0.1, 0.0, 0.0), False, clock(), stamp_ns=0))
+    assert lock.wait(0.0)                                     # the wait ends: a command came
     outbox.clear()
     lock.due(outbox)
     assert body.steps == 10 and [s.stamp_ns for s in outbox] == [5 * MS, 10 * MS]
     assert lock.ticks == 1 and lock.misses == 0
     lock.due(outbox)
     assert body.steps == 10                                   # the held command is for t_0
-    assert lock.command((0.2, 0.0, 0.0), False, clock(), stamp_ns=5 * MS) == ['stale']
-    assert body.counts['stale'] == 1 and body.command_held.vector == (0.1, 0.0, 0.0)
-    lock.command((0.2, 0.0, 0.0), False, clock(), stamp_ns=10 * MS)
+    lock.mailbox.put(TorqueCommands.one((0.2, 0.0, 0.0), False, clock(), stamp_ns=5 * MS))
+    lock.due(outbox)
+    assert body.steps == 10 and body.counts['stale'] == 1
+    assert body.command_held.vector == (0.1, 0.0, 0.0) and body.take_events() == {
+        'accepted', 'stale'}
+    lock.mailbox.put(TorqueCommands.one((0.2, 0.0, 0.0), False, clock(), stamp_ns=10 * MS))
     lock.due(outbox)
     assert body.steps == 20
     # the same commands offline: a body stepped with 0.1 for 10 steps, then 0.2 for 10
@@ -370,7 +367,7 @@ def test_lockstep_waits_for_each_tick_and_holds_from_it():
     lock.due(outbox)
     assert body.steps == 40 and lock.misses == 2 and body.command_held.vector == (0.2, 0.0, 0.0)
     assert len([n for n in body.take_notes() if 'lockstep: no torque_cmd' in n]) == 1
-    lock.command((0.0, 0.0, 0.0), False, clock(), stamp_ns=40 * MS)
+    lock.mailbox.put(TorqueCommands.one((0.0, 0.0, 0.0), False, clock(), stamp_ns=40 * MS))
     lock.due(outbox)
     assert body.steps == 50 and any('answered again after 2' in n for n in body.take_notes())
     mean, worst = lock.take_wait()
@@ -385,7 +382,7 @@ def test_lockstep_publishes_the_tick_state_when_it_is_not_a_publish_tick():
     body = make_body(publish_every=7, torque_timeout=0.0)
     lock = Lockstep(body, control_every=10, timeout=0.0, clock=clock, perf=clock.perf)
     outbox = []
-    lock.command((0.0, 0.0, 0.0), False, clock(), stamp_ns=0)
+    lock.mailbox.put(TorqueCommands.one((0.0, 0.0, 0.0), False, clock(), stamp_ns=0))
     lock.due(outbox)
     assert [s.stamp_ns for s in outbox] == [7 * MS, 10 * MS]
     assert [s.odom_only for s in outbox] == [False, True]     # the tick: odom (clock, TF)
@@ -533,19 +530,22 @@ def test_a_batch_of_commands_counts_and_holds_as_one_by_one():
     one, many = make_body(max_torque=0.25), make_body(max_torque=0.25)
     for v, f in zip(vectors, forces):
         one.command(v, False, 7, force=tuple(f))
-    whole = many.batch(vectors, False, forces)
-    events = whole.apply(0, whole.size, 7)
+    whole = many.check(TorqueCommands([7] * 40, vectors, False, forces=forces))
+    events = many.hold(whole, 0, len(whole))
     assert many.counts == one.counts and many.command_held == one.command_held
     assert events == {'accepted', 'clipped', 'force_ignored', 'rejected_non_finite'}
     assert many.counts['rejected_non_finite'] == 3 and many.counts['force_ignored'] == 2
     nothing = make_body()
-    assert nothing.batch(np.full((2, 3), np.nan), True).apply(0, 2, 0) == {'rejected_non_finite'}
+    refused = nothing.check(TorqueCommands([0, 0], np.full((2, 3), np.nan), True))
+    assert nothing.hold(refused, 0, 2) == {'rejected_non_finite'}
     assert nothing.command_held is None
     # in slices (what a pace does, a slice per step): after each slice, as one by one
     sliced, ref = make_body(max_torque=0.25), make_body(max_torque=0.25)
-    batch = sliced.batch(vectors, False, forces)
-    for start, stop in ((0, 3), (3, 4), (4, 17), (17, 18), (18, 40)):
-        batch.apply(start, stop, 100 + stop)
+    slices = ((0, 3), (3, 4), (4, 17), (17, 18), (18, 40))
+    received = [100 + stop for start, stop in slices for _ in range(start, stop)]
+    batch = sliced.check(TorqueCommands(received, vectors, False, forces=forces))
+    for start, stop in slices:
+        sliced.hold(batch, start, stop)
         for v, f in zip(vectors[start:stop], forces[start:stop]):
             ref.command(v, False, 100 + stop, force=tuple(f))
         assert sliced.counts == ref.counts and sliced.command_held == ref.command_held

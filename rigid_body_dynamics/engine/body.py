@@ -23,6 +23,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .commands import TorqueCommands
 from ..physics import make_integrator, quaternions
 from ..physics.disturbances import GravityGradient
 from ..physics.sensors import GyroErrors, GyroModel
@@ -109,66 +110,43 @@ class Snapshot(NamedTuple):
     odom_only: bool = False    # lockstep's tick state between publish ticks: odom (and clock, TF)
 
 
-class CommandBatch:
+class CheckedTorques:
     """
-    Torque commands of one frame taken together, checked at once, applied in slices.
+    Torque commands checked at once, for the body to count and hold in slices.
 
-    Made by :meth:`BodySimulation.batch`. ``apply(start, stop, at_ns)`` counts
-    commands ``start:stop`` as :meth:`BodySimulation.command` one after the other
-    would (non-finite refused, components beyond ``max_torque`` clipped, forces
-    ignored) and holds the newest finite one as having arrived at ``at_ns``
-    (steady int ns); it returns the set of events. A pace applies each step's
-    arrivals just before that step, so a flood of N commands costs one check of
-    N vectors and a few integer operations per step.
+    Made by :meth:`BodySimulation.check`, read by :meth:`BodySimulation.hold`.
+
+    Plain data, read by the body only: the clipped vectors, the running counts of
+    refused, clipped and force-carrying commands before each index, and the newest
+    finite index at or before each. So a flood of N commands costs one check of N
+    vectors, and a slice a few integer operations.
     """
 
-    def __init__(self, body, vectors, world, forces):
-        v = np.asarray(vectors, dtype=float).reshape(-1, 3)
+    kind = 'torque'
+
+    def __init__(self, commands, max_torque):
+        v = commands.torques
         n = len(v)
         finite = np.all(np.isfinite(v), axis=1)
-        limit = body.max_torque
-        if limit > 0.0:
-            over = finite & np.any(np.abs(v) > limit, axis=1)
-            v = np.clip(v, -limit, limit)
+        if max_torque > 0.0:
+            over = finite & np.any(np.abs(v) > max_torque, axis=1)
+            v = np.clip(v, -max_torque, max_torque)
         else:
             over = np.zeros(n, dtype=bool)
-        if forces is not None:
-            f = np.asarray(forces, dtype=float).reshape(-1, 3)
-            pushed = finite & np.any((f != 0.0) | ~np.isfinite(f), axis=1)
-        else:
-            pushed = np.zeros(n, dtype=bool)
-        self.body, self.world, self.size = body, bool(world), n
-        self._vectors = v.tolist()
+        f = commands.forces
+        pushed = finite & np.any((f != 0.0) | ~np.isfinite(f), axis=1) if f is not None \
+            else np.zeros(n, dtype=bool)
+        self.received_ns = commands.received_ns
+        self.stamps_ns = commands.stamps_ns
+        self.vectors = v.tolist()
+        self.world = commands.world.tolist()
         # counts of commands before index i, and the newest finite index at or before i
-        self._bad, self._over, self._pushed = (
+        self.bad, self.over, self.pushed = (
             [0] + np.cumsum(mask).tolist() for mask in (~finite, over, pushed))
-        self._newest = np.maximum.accumulate(np.where(finite, np.arange(n), -1)).tolist()
+        self.newest = np.maximum.accumulate(np.where(finite, np.arange(n), -1)).tolist()
 
-    def apply(self, start, stop, at_ns):
-        """Count commands start:stop and hold the newest finite one; the set of events."""
-        body, events = self.body, set()
-        with body.lock:
-            counts = body.counts
-            bad = self._bad[stop] - self._bad[start]
-            if bad:
-                counts['rejected_non_finite'] += bad
-                events.add('rejected_non_finite')
-            good = stop - start - bad
-            if not good:
-                return events
-            over = self._over[stop] - self._over[start]
-            if over:
-                counts['clipped'] += over
-                events.add('clipped')
-            pushed = self._pushed[stop] - self._pushed[start]
-            if pushed:
-                counts['force_ignored'] += pushed
-                events.add('force_ignored')
-            counts['accepted'] += good
-            events.add('accepted')
-            body.command_held = body._make_command(tuple(self._vectors[self._newest[stop - 1]]),
-                                                   self.world, int(at_ns))
-        return events
+    def __len__(self):
+        return len(self.received_ns)
 
 
 class BodySimulation:
@@ -182,16 +160,22 @@ class BodySimulation:
     (steps per gyro sample, 0 = none), ``gyro`` (GyroErrors; None = perfect) and
     its ``seed``, ``start_ns`` (stamp of simulated time 0), ``disturbances``
     (:class:`Disturbances`; None = none). ``notes`` collects what a node should
-    log (the watchdog's timeouts), drained with :meth:`take_notes`.
+    log (the watchdog's timeouts, lockstep's misses), drained with
+    :meth:`take_notes`; ``events`` the command events since the last
+    :meth:`take_events` (for the node's warnings).
+
+    Commands come as values (:mod:`.commands`) through :meth:`check` and
+    :meth:`hold`, the one path a pace uses in every mode; :meth:`command` is
+    that path for a single torque. Only the body writes its fields.
 
     ``lock`` (re-entrant) guards the state. The methods other threads call take it
     themselves: :meth:`reset`, :meth:`set_paused`, :meth:`configure`,
-    :meth:`command`, :meth:`batch`, :meth:`reject`, :meth:`take_notes`,
-    :meth:`health`. The stepping methods are called by the one thread that
-    holds it for a whole wake (the engine's Pace or Lockstep) and say "call
-    under ``lock``": :meth:`advance`, :meth:`advance_free`, :meth:`torque_now`,
-    :meth:`first_items`, :meth:`imu_sample`, :meth:`snapshot`,
-    :meth:`invariants`, :meth:`body_state`.
+    :meth:`check`, :meth:`hold`, :meth:`command`, :meth:`reject`, :meth:`note`,
+    :meth:`take_notes`, :meth:`take_events`, :meth:`health`. The stepping methods
+    are called by the one thread that holds it for a whole wake (the engine's
+    Pace or Lockstep) and say "call under ``lock``": :meth:`advance`,
+    :meth:`advance_free`, :meth:`torque_now`, :meth:`first_items`,
+    :meth:`imu_sample`, :meth:`snapshot`, :meth:`invariants`, :meth:`body_state`.
     """
 
     def __init__(self, inertia, integrator, rate, initial, torque_timeout=0.5, max_torque=0.0,
@@ -214,6 +198,7 @@ class BodySimulation:
         self.disturbances = disturbances or Disturbances()
         self.counts = dict.fromkeys(COUNTS, 0)
         self.notes = []
+        self.events = set()
         self.reset()
 
     # ------------------------------------------------------------------ state
@@ -331,51 +316,85 @@ class BodySimulation:
             principal = tuple(float(c) for c in self.inertia.to_principal(np.array(vector)))
         return TorqueCommand(tuple(vector), world, received_ns, principal, stamp_ns)
 
+    def check(self, commands):
+        """
+        Check a command value at once (e.g. TorqueCommands): a value for :meth:`hold`.
+
+        Takes the lock (the limits read are the current ones).
+        """
+        with self.lock:
+            if commands.kind == 'torque':
+                return CheckedTorques(commands, self.max_torque)
+            raise ValueError(f'unknown kind of command {commands.kind!r}')
+
+    def hold(self, checked, start, stop):
+        """
+        Take commands ``start:stop`` of ``checked`` (from :meth:`check`) as having arrived.
+
+        They are counted as they would be one after the other (non-finite refused,
+        components beyond ``max_torque`` clipped, forces ignored), and the newest
+        finite one is held from now on, with the receive time of command
+        ``stop - 1``. Returns the set of events, which are also kept for
+        :meth:`take_events`. Takes the lock.
+        """
+        events = set()
+        with self.lock:
+            counts = self.counts
+            bad = checked.bad[stop] - checked.bad[start]
+            if bad:
+                counts['rejected_non_finite'] += bad
+                events.add('rejected_non_finite')
+            good = stop - start - bad
+            if good:
+                over = checked.over[stop] - checked.over[start]
+                if over:
+                    counts['clipped'] += over
+                    events.add('clipped')
+                pushed = checked.pushed[stop] - checked.pushed[start]
+                if pushed:
+                    counts['force_ignored'] += pushed
+                    events.add('force_ignored')
+                counts['accepted'] += good
+                events.add('accepted')
+                i = checked.newest[stop - 1]
+                self.command_held = self._make_command(
+                    tuple(checked.vectors[i]), checked.world[i], checked.received_ns[stop - 1],
+                    None if checked.stamps_ns is None else checked.stamps_ns[i])
+            self.events |= events
+        return events
+
     def command(self, vector, world, now_ns, force=_ZERO, stamp_ns=None):
         """
-        Hold a new torque: N m in the body frame, or in the world frame if ``world``.
+        Hold one torque now: N m in the body frame, or in the world frame if ``world``.
 
-        ``stamp_ns``: the command's header stamp (int ns), kept with it (lockstep
-        waits for a command stamped at or after the current tick).
-
-        A non-finite torque is refused and counted (returns 'rejected_non_finite',
-        the state untouched); a component beyond ``max_torque`` is clipped and
-        counted; a force is ignored and counted. Returns the list of what
-        happened: any of 'clipped', 'force_ignored', and 'accepted'.
+        The same path as a pace's (:meth:`check`, then :meth:`hold`), for one
+        command received at ``now_ns`` (steady int ns) and stamped ``stamp_ns``
+        (int ns or None). Returns the set of events ('accepted', 'clipped',
+        'force_ignored', or 'rejected_non_finite' with the state untouched).
         """
-        vector = tuple(float(c) for c in vector)
-        with self.lock:
-            if not all(math.isfinite(c) for c in vector):
-                self.counts['rejected_non_finite'] += 1
-                return ['rejected_non_finite']
-            events = []
-            limit = self.max_torque
-            if limit > 0.0 and any(abs(c) > limit for c in vector):
-                vector = tuple(min(max(c, -limit), limit) for c in vector)
-                events.append('clipped')
-            if not all(math.isfinite(c) for c in force) or any(force):
-                events.append('force_ignored')
-            events.append('accepted')
-            for event in events:
-                self.counts[event] += 1
-            self.command_held = self._make_command(vector, bool(world), int(now_ns), stamp_ns)
-            return events
-
-    def batch(self, vectors, world, forces=None):
-        """
-        Check many commands at once: a :class:`CommandBatch` to apply in slices.
-
-        ``vectors`` (N, 3) N m, all body or all ``world`` frame; ``forces`` (N, 3)
-        or None. Applied whole (``apply(0, N, now_ns)``) it counts and holds as
-        :meth:`command` one after the other would.
-        """
-        with self.lock:
-            return CommandBatch(self, vectors, world, forces)
+        one = TorqueCommands.one(vector, world, now_ns, stamp_ns, force)
+        return self.hold(self.check(one), 0, 1)
 
     def reject(self, reason, count=1):
-        """Count ``count`` commands refused before they got here (e.g. 'rejected_frame')."""
+        """
+        Count ``count`` commands refused before they were held; the reason is also an event.
+
+        E.g. 'rejected_frame' (the decoder) or 'stale' (lockstep). Takes the lock.
+        """
         with self.lock:
             self.counts[reason] += count
+            self.events.add(reason)
+
+    def note(self, text):
+        """Add a line for the node's log (:meth:`take_notes`). Takes the lock."""
+        with self.lock:
+            self.notes.append(text)
+
+    def take_events(self):
+        """Return and forget the set of command events since the last call (for warnings)."""
+        with self.lock:
+            events, self.events = self.events, set()
+        return events
 
     def torque_now(self, now_ns):
         """

@@ -16,10 +16,10 @@ is a miss: counted, noted for the log, and the last command is held. A
 command stamped before the current tick (an answer that came too late) is
 counted as ``stale`` and not used: using it would make the run depend on
 timing. Interface as :class:`~.pacer.Pace` (``due(outbox)`` returns the wall
-time to wait), so the node's integration thread drives either.
+time to wait, commands come from ``inbox()`` as the same values), so the node's
+integration thread drives either.
 """
 
-import threading
 import time
 
 from .pacer import Pace, PAUSED_WAIT
@@ -37,17 +37,15 @@ class Lockstep(Pace):
 
     Counters: ``ticks`` answered, ``misses``, ``wait_ns`` (total wall time
     spent waiting for answered ticks after the first) and ``max_wait_ns`` since
-    :meth:`take_wait`. ``wait_for_commands(timeout_s)``: how the waiting
-    thread waits (default: for :meth:`command` to set ``arrived``); a node
-    passes one that takes the pending commands itself and feeds them to
-    :meth:`command`.
+    :meth:`take_wait`. Commands come from ``inbox()`` as in :class:`~.pacer.Pace`
+    (default: the pace's ``mailbox``); ``wait(timeout_s)`` blocks until one is
+    pending (default: the mailbox's; a node passes its subscription's wait).
     """
 
     def __init__(self, body, control_every, timeout, clock=time.monotonic_ns,
-                 perf=time.perf_counter, wait_for_commands=None):
-        super().__init__(body, 0.0, clock=clock, perf=perf)
-        self.arrived = threading.Event()
-        self.wait_for_commands = wait_for_commands or self.arrived.wait
+                 perf=time.perf_counter, inbox=None, wait=None):
+        super().__init__(body, 0.0, clock=clock, perf=perf, inbox=inbox)
+        self.wait = wait if wait is not None else self.mailbox.wait
         self.control_every = int(control_every)
         if self.control_every < 1:
             raise ValueError(f'control_every must be >= 1, got {control_every!r}')
@@ -66,22 +64,25 @@ class Lockstep(Pace):
     def set_rtf(self, rtf):
         """Lockstep runs as fast as the controller answers: the real-time factor is unused."""
 
-    def command(self, vector, world, now_ns, stamp_ns, force=(0.0, 0.0, 0.0)):
+    def _take(self):
         """
-        Take a command stamped ``stamp_ns`` (int ns); returns the body's events.
+        Take the inbox's commands; drop those stamped before the current tick.
 
-        Stamped before the current tick: counted ``stale`` and dropped
-        (returns ['stale']). Otherwise as ``BodySimulation.command``, and the
-        waiting tick is woken.
+        A dropped command is counted ``stale`` (an answer that came after its tick
+        was closed: using it would make the run depend on timing); one without a
+        stamp cannot answer a tick and is held as in real time.
         """
-        body = self.body
-        with body.lock:
-            if stamp_ns < body.stamp_now():
-                body.counts['stale'] += 1
-                return ['stale']
-            events = body.command(vector, world, now_ns, force=force, stamp_ns=stamp_ns)
-        self.arrived.set()
-        return events
+        body, taken = self.body, []
+        now = body.stamp_now()
+        for value in self.inbox():
+            if value.stamps_ns is not None:
+                fresh = [s >= now for s in value.stamps_ns]
+                if not all(fresh):
+                    body.reject('stale', fresh.count(False))
+                    value = value.select(fresh)
+            if len(value):
+                taken.append((body.check(value), 0))
+        return taken
 
     def due(self, outbox):
         """
@@ -95,7 +96,7 @@ class Lockstep(Pace):
             if body.paused:
                 return PAUSED_WAIT
             now = self.clock()
-            self.arrived.clear()
+            self._hold_all()
             cmd = body.command_held
             answered = cmd is not None and cmd.stamp_ns is not None and \
                 cmd.stamp_ns >= body.stamp_now()
@@ -114,7 +115,7 @@ class Lockstep(Pace):
                 return 0.0
             left = (self.timeout_ns - waited) / _NS if self.timeout_ns and not self._first \
                 else WAIT_SLICE
-        self.wait_for_commands(min(max(left, 0.0), WAIT_SLICE))
+        self.wait(min(max(left, 0.0), WAIT_SLICE))
         return 0.0
 
     def _close_tick(self, answered, waited):
@@ -125,13 +126,13 @@ class Lockstep(Pace):
                 self.wait_ns += waited
                 self.max_wait_ns = max(self.max_wait_ns, waited)
             if self._streak:
-                body.notes.append(f'lockstep: the controller answered again after '
-                                  f'{self._streak} missed ticks')
+                body.note(f'lockstep: the controller answered again after '
+                          f'{self._streak} missed ticks')
             self._first, self._streak = False, 0
             return
         self.misses += 1
         if not self._streak:
-            body.notes.append(
+            body.note(
                 f'lockstep: no torque_cmd stamped at or after t = {body.steps * body.dt:.6g} s '
                 f'within {self.timeout_ns / _NS:g} s; holding the last command and going on '
                 '(said once until the controller answers again)')

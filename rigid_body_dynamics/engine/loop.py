@@ -62,7 +62,7 @@ class Loop:
         # members whose schedule moved (reset, resume, new rate: Pace.anchor): look at once
         self._moved = collections.deque()
         for k, member in enumerate(self.members):
-            member.pace.on_anchor = functools.partial(self._moved.append, k)
+            member.pace.on_move(functools.partial(self._moved.append, k))
         # diagnostics one member at a time, spread evenly over the period: all of a fleet's at
         # once (0.5 ms each here) queued 20-50 ms of publishing at every period, the queue
         # overflowed its backlog limit and was published in one go, and every body's next

@@ -21,6 +21,8 @@ the wake-ups for the defaults (1 kHz steps, 100 Hz publishing).
 import math
 import time
 
+from .commands import Mailbox
+
 _NS = 1_000_000_000
 #: Wall time the pacing may fall behind before the backlog is dropped (s).
 MAX_LAG = 0.25
@@ -56,27 +58,30 @@ class Pace:
     :meth:`take_max_late`; ``on_backlog(steps)`` is called when a backlog
     over MAX_LAG is dropped.
 
-    ``take_commands()``, if given, is called at every wake before the due
-    steps and returns None (nothing came) or ``(received, apply)``: the
-    steady receive times (int ns, oldest first) of the commands taken and
-    ``apply(start, stop, at_ns)``, which hands commands ``start:stop`` to the
-    body as having arrived at ``at_ns``. A command is applied before the
-    first due step whose deadline is at or after its receive time (so it acts
-    from the step during which it came, as if the body had been stepped at
-    every deadline); one that came after the last due deadline, after them.
+    Commands come from ``inbox()`` (default: a :class:`~.commands.Mailbox`, kept
+    as ``mailbox``), called at every wake before the due steps: a list of command
+    values (:mod:`.commands`), each N commands oldest first with their steady
+    receive times. The body checks each value at once; a command is held
+    (:meth:`~.body.BodySimulation.hold`) before the first due step whose deadline
+    is at or after its receive time, so it acts from the step during which it
+    came, as if the body had been stepped at every deadline; one that came after
+    the last due deadline, after them. This is the one path of a command in every
+    mode: as fast as possible it is held at once, and :class:`~.lockstep.Lockstep`
+    takes the same values.
     """
 
     def __init__(self, body, rtf, clock=time.monotonic_ns, perf=time.perf_counter,
-                 on_backlog=None, take_commands=None):
+                 on_backlog=None, inbox=None):
         self.body = body
-        self.take_commands = take_commands
+        self.mailbox = Mailbox() if inbox is None else None
+        self.inbox = self.mailbox.take if inbox is None else inbox
         self.rtf = float(rtf)
         self.clock, self.perf = clock, perf
         self.on_backlog = on_backlog or (lambda steps: None)
         self.missed = 0
         self.max_late_ns = 0
         self.phase = 0.0
-        self.on_anchor = None       # called by anchor(): an engine Loop sets it
+        self._on_move = []          # called by anchor(): see on_move
         self._target = 0            # the step the next wake is for (0: the next one)
         self.anchor()
         self._stats = self._woke = (clock(), body.steps)
@@ -99,8 +104,12 @@ class Pace:
         self.anchor_ns = now - now % period + self.phase * period
         self.anchor_steps = self.body.steps
         self._target = 0
-        if self.on_anchor is not None:
-            self.on_anchor()             # tell the Loop: the next step may be earlier now
+        for callback in self._on_move:
+            callback()                   # e.g. tell the Loop: the next step may be earlier now
+
+    def on_move(self, callback):
+        """Call ``callback()`` whenever the schedule moves (:meth:`anchor`: reset, resume...)."""
+        self._on_move.append(callback)
 
     def set_phase(self, phase):
         """
@@ -161,7 +170,7 @@ class Pace:
             if body.paused:
                 return PAUSED_WAIT
             if self.rtf == 0.0:
-                self._apply_all()
+                self._hold_all()
                 end = self.perf() + AFAP_BATCH
                 while self.perf() < end:
                     body.advance(self.clock(), outbox)
@@ -184,7 +193,7 @@ class Pace:
                 self._steps_to(due_steps, outbox)
                 self._woke = (now, due_steps)
             else:
-                self._apply_all()
+                self._hold_all()
             return max(0.0, (self.deadline(self._next_target()) - self.clock()) / _NS)
 
     def deadline(self, step):
@@ -193,37 +202,50 @@ class Pace:
         return self.anchor_ns + int((step - self.anchor_steps) * period)
 
     def _steps_to(self, due_steps, outbox):
-        """Integrate up to step ``due_steps``, each with the command newest at its deadline."""
+        """Integrate up to step ``due_steps``, each with the commands newest at its deadline."""
         body = self.body
-        received, apply = self._take()
-        i, n = 0, len(received)
+        pending = self._take()
+        coming = self._next_arrival(pending)
         # (self.deadline(step), inlined: this loop runs at every step of every body)
         anchor_ns, anchor_steps, period = self.anchor_ns, self.anchor_steps, body.dt_ns / self.rtf
         for step in range(body.steps + 1, due_steps + 1):
             at = anchor_ns + int((step - anchor_steps) * period)
-            if i < n and received[i] <= at:
-                j = i + 1
-                while j < n and received[j] <= at:
-                    j += 1
-                apply(i, j, received[j - 1])
-                i = j
+            if coming <= at:
+                pending = self._hold_until(pending, at)
+                coming = self._next_arrival(pending)
             rest = due_steps - step + 1
-            if i == n and rest > 1 and body.advance_free(rest, at, outbox):
+            if not pending and rest > 1 and body.advance_free(rest, at, outbox):
                 break        # the rest torque-free and no command to come in between: at once
             body.advance(at, outbox)
-        if i < n:
-            apply(i, n, received[n - 1])
+        self._hold_until(pending, math.inf)
 
-    def _apply_all(self):
-        """Hand every pending command to the body at once (no step due, or as fast as possible)."""
-        received, apply = self._take()
-        if received:
-            apply(0, len(received), received[-1])
+    def _hold_until(self, pending, at_ns):
+        """Hold the commands received by ``at_ns``; the [checked, next index] still to come."""
+        body, left = self.body, []
+        for checked, i in pending:
+            received, n = checked.received_ns, len(checked)
+            j = i
+            while j < n and received[j] <= at_ns:
+                j += 1
+            if j > i:
+                body.hold(checked, i, j)
+            if j < n:
+                left.append((checked, j))
+        return left
+
+    @staticmethod
+    def _next_arrival(pending):
+        """Return the earliest receive time (int ns) still to hold, or inf."""
+        return min((checked.received_ns[i] for checked, i in pending), default=math.inf)
+
+    def _hold_all(self):
+        """Hold every pending command at once (no step due, or as fast as possible)."""
+        self._hold_until(self._take(), math.inf)
 
     def _take(self):
-        """Take the pending commands: (steady receive times, apply), or ((), None)."""
-        taken = self.take_commands() if self.take_commands is not None else None
-        return taken if taken is not None else ((), None)
+        """Take the inbox's command values, checked by the body: [(checked, 0), ...]."""
+        body = self.body
+        return [(body.check(value), 0) for value in self.inbox() if len(value)]
 
     def _next_target(self):
         """Return the step the next wake is for: the next that publishes, or COMMAND_LOOK s on."""

@@ -34,7 +34,6 @@ import math
 import os
 import sys
 import threading
-import time
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
@@ -42,17 +41,15 @@ import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.serialization import deserialize_message
 from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
 from .simulator_diagnostics import SimulatorReport
 from .simulator_parameters import PARAMETERS, state_topics
-from .. import cdr
 from ..engine import BodySimulation, Lockstep, Loop, Member, Pace
 from ..physics import presets
 from ..physics.sensors import GyroErrors
-from ..ros import conversions as conv
+from ..ros.command_decoder import steady_times, TorqueDecoder
 from ..ros.intake import Intake
 from ..ros.runner import run
 from ..ros.state_publisher import StatePublisher, tf_available
@@ -141,12 +138,15 @@ class AttitudeSimulator(Node):
                             values['orientation_noise'], values['gyro_resolution']),
             seed=values['noise_seed'], disturbances=values['disturbances'])
         self._publish_rate = values['publish_rate']
+        self._decoder = TorqueDecoder(self._frames)
+        self._refused_frame = ''
         if self.lockstep:
             self.pace = Lockstep(self.body, values['control_every'], values['lockstep_timeout'],
-                                 wait_for_commands=self._take_torque)
+                                 inbox=self._inbox,
+                                 wait=lambda timeout: self._intake.wait('torque_cmd', timeout))
         else:
             self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog,
-                             take_commands=self._arrivals)
+                             inbox=self._inbox)
         self._report = SimulatorReport(self.body, self.pace, self.lockstep)
         self._make_interfaces()
         self.state.publish_inertia(self.body.inertia, start_ns)
@@ -221,93 +221,43 @@ class AttitudeSimulator(Node):
         self.create_service(SetBool, '~/pause', self._on_pause)
 
     # ------------------------------------------------------------------ torque
-    def _on_torque(self, msg, now_ns=None):
-        """Check, count and hold one command (``now_ns``: its steady arrival time; now)."""
-        now_ns = time.monotonic_ns() if now_ns is None else now_ns
-        warn = self._warnings.warn
-        frame = msg.header.frame_id
-        if not conv.is_finite_vector(msg.wrench.torque):
-            self.body.reject('rejected_non_finite')
-            self._warn_events({'rejected_non_finite'})
-            return
-        world_frame, body_frame = self._frames
-        if frame not in ('', body_frame, world_frame):
-            self.body.reject('rejected_frame')
-            self._warn_frame(frame)
-            return
-        f = msg.wrench.force
-        vector, world = conv.vector_array(msg.wrench.torque), \
-            frame == world_frame and frame != body_frame
-        if self.lockstep:
-            events = self.pace.command(vector, world, now_ns, conv.time_ns(msg.header.stamp),
-                                       force=(f.x, f.y, f.z))
-            if 'stale' in events:
-                warn('stale', 'lockstep: torque_cmd stamped before the current tick dropped '
-                     '(an answer that came after its tick was missed)')
-        else:
-            events = self.body.command(vector, world, now_ns, force=(f.x, f.y, f.z))
-        self._warn_events(events)
+    def _inbox(self):
+        """
+        Return the torque_cmd messages pending, decoded into command values (the pace's inbox).
 
-    def _warn_frame(self, frame):
-        world_frame, body_frame = self._frames
-        shown = frame if len(frame) <= 64 else frame[:64] + '...'
-        self._warnings.warn('frame', f'torque_cmd rejected: unknown frame_id {shown!r}; use '
-                            f'{body_frame!r}, {world_frame!r} or "" (= body)')
+        Called by the integration thread at every wake (under the body's lock);
+        commands in an unknown frame are counted here, everything else is the
+        engine's (:meth:`BodySimulation.hold`).
+        """
+        received = []
+        raws = self._intake.take('torque_cmd', received=received)
+        if not raws:
+            return ()
+        commands, refused = self._decoder.decode(raws, steady_times(received))
+        for frame, count in refused.items():
+            self._refused_frame = frame
+            self.body.reject('rejected_frame', count)
+        return (commands,)
 
     def _warn_events(self, events):
+        """Warn (throttled) about the command events the body reported."""
         warn = self._warnings.warn
         if 'rejected_non_finite' in events:
             warn('non-finite', 'torque_cmd rejected: non-finite torque; state unchanged')
+        if 'rejected_frame' in events:
+            frame = self._refused_frame
+            shown = frame if len(frame) <= 64 else frame[:64] + '...'
+            warn('frame', f'torque_cmd rejected: unknown frame_id {shown!r}; use '
+                 f'{self._decoder.body_frame!r}, {self._decoder.world_frame!r} or "" (= body)')
         if 'clipped' in events:
             warn('clipped', f'torque_cmd clipped to max_torque = {self.body.max_torque:g} N m '
                  'per axis')
         if 'force_ignored' in events:
             warn('force', 'torque_cmd carries a force; only the torque is used (the body '
                  'does not translate)', period=math.inf)
-
-    def _take_torque(self, timeout):
-        """Lockstep: take every pending torque_cmd, waiting up to ``timeout`` s for one."""
-        if not self._intake.wait('torque_cmd', timeout):
-            return
-        for raw in self._intake.take('torque_cmd'):
-            self._on_torque(deserialize_message(raw, WrenchStamped))
-
-    def _arrivals(self):
-        """
-        Take every pending torque_cmd for the Pace: (steady receive times, apply) or None.
-
-        The batch is decoded at once when its messages share one frame (a
-        flood costs little), else one by one; ``apply(start, stop, at_ns)``
-        counts and checks commands start:stop as having arrived at ``at_ns``.
-        """
-        stamps = []
-        raws = self._intake.take('torque_cmd', received=stamps)
-        if not raws:
-            return None
-        now = time.monotonic_ns()
-        offset = time.time_ns() - now            # system clock -> steady clock
-        received = [min(r - offset, now) if r else now for r in stamps]
-        try:
-            _, torques, frame, forces = cdr.wrench_arrays(raws, force=True)
-        except cdr.NotUniform:
-            messages = [deserialize_message(raw, WrenchStamped) for raw in raws]
-
-            def apply(start, stop, at_ns):
-                for msg in messages[start:stop]:
-                    self._on_torque(msg, at_ns)
-            return received, apply
-        return received, self._batch_applier(torques, frame, forces)
-
-    def _batch_applier(self, torques, frame, forces):
-        """apply(start, stop, at_ns) for commands of one frame: checked as _on_torque does."""
-        world_frame, body_frame = self._frames
-        if frame not in ('', body_frame, world_frame):
-            def refuse(start, stop, _at_ns):
-                self.body.reject('rejected_frame', stop - start)
-                self._warn_frame(frame)
-            return refuse
-        batch = self.body.batch(torques, frame == world_frame and frame != body_frame, forces)
-        return lambda start, stop, at_ns: self._warn_events(batch.apply(start, stop, at_ns))
+        if 'stale' in events:
+            warn('stale', 'lockstep: torque_cmd stamped before the current tick dropped '
+                 '(an answer that came after its tick was missed)')
 
     def destroy_node(self):
         """Destroy the torque intake's helper node too."""
@@ -344,18 +294,18 @@ class AttitudeSimulator(Node):
 
     def stop(self):
         """Stop the integration thread and wait for it."""
-        self._stop.set()
-        if self.lockstep:
-            self.pace.arrived.set()       # wake a lockstep wait
+        self._stop.set()                  # (a lockstep wait ends within WAIT_SLICE)
         if self._thread is not None:
             self._thread.join(timeout=5.0)
 
     def log_notes(self):
-        """Log what the body noted while stepping (the watchdog's timeouts)."""
-        if not self.body.notes:           # (read without the lock: a list's truth is atomic)
-            return
-        for note in self.body.take_notes():
-            self.get_logger().info(note)
+        """Log what the body noted while stepping (timeouts, misses) and warn of command events."""
+        body = self.body                  # (read without the lock: a container's truth is atomic)
+        if body.events:
+            self._warn_events(body.take_events())
+        if body.notes:
+            for note in body.take_notes():
+                self.get_logger().info(note)
 
     def _on_backlog(self, behind):
         self._warnings.warn('backlog', f'cannot keep up with real_time_factor {self.pace.rtf:g}: '

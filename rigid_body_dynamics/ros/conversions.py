@@ -4,7 +4,6 @@ Message <-> numpy conversions, in one place.
 Quaternions are (x, y, z, w) on both sides. Times are integer nanoseconds.
 """
 
-import math
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
@@ -43,11 +42,6 @@ def vector_msg(v):
 def vector_array(msg):
     """3-array from geometry_msgs/Vector3."""
     return np.array([msg.x, msg.y, msg.z])
-
-
-def is_finite_vector(msg):
-    """Tell whether all components of a Vector3 are finite."""
-    return math.isfinite(msg.x) and math.isfinite(msg.y) and math.isfinite(msg.z)
 
 
 def status(name, level, message, values, hardware_id='none'):

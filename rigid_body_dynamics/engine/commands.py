@@ -1,0 +1,101 @@
+"""
+Commands as values: what a node decodes from its messages and the engine takes, without ROS.
+
+There is one path for a command, whatever the pacing (real time, as fast as
+possible, lockstep, a fleet's bodies):
+
+1. a decoder (the node's, :mod:`rigid_body_dynamics.ros.command_decoder`) turns the
+   messages taken from a topic into one value, e.g. :class:`TorqueCommands`: N
+   commands, oldest first, each with its steady-clock receive time;
+2. the pace (:class:`~.pacer.Pace` or :class:`~.lockstep.Lockstep`) takes the values
+   from its ``inbox()`` at every wake and has the body check each at once
+   (:meth:`~.body.BodySimulation.check`);
+3. it hands the body the commands that came by each step's deadline
+   (:meth:`~.body.BodySimulation.hold`), which counts them and holds the newest.
+
+A new kind of command is a new value class (with ``kind``, ``received_ns``,
+``stamps_ns``, ``__len__`` and ``select``) and its decoder, and the body's rule for
+it; the paces do not change. :class:`Mailbox` is an inbox for code without ROS
+(tests, a Python controller in the same process).
+"""
+
+import threading
+
+import numpy as np
+
+
+class TorqueCommands:
+    """
+    N torque commands, oldest first (kind ``'torque'``).
+
+    ``received_ns``: steady-clock receive times (int ns, non-decreasing);
+    ``torques`` (N, 3) N m, each in the body frame or, where ``world`` is true,
+    in the world frame (``world``: one bool for all, or N); ``stamps_ns``: the
+    messages' header stamps (int ns) or None; ``forces`` (N, 3) N or None (a
+    non-zero force is ignored and counted: the body does not translate).
+    Non-finite values are kept: the body refuses and counts them.
+    """
+
+    kind = 'torque'
+    __slots__ = ('received_ns', 'torques', 'world', 'stamps_ns', 'forces')
+
+    def __init__(self, received_ns, torques, world=False, stamps_ns=None, forces=None):
+        self.received_ns = [int(t) for t in received_ns]
+        n = len(self.received_ns)
+        self.torques = np.asarray(torques, dtype=float).reshape(n, 3)
+        self.world = np.broadcast_to(np.asarray(world, dtype=bool), (n,))
+        self.stamps_ns = None if stamps_ns is None else [int(s) for s in stamps_ns]
+        self.forces = None if forces is None else np.asarray(forces, dtype=float).reshape(n, 3)
+
+    @classmethod
+    def one(cls, torque, world, received_ns, stamp_ns=None, force=None):
+        """Return a single command: ``torque`` (3,) N m, body or ``world`` frame."""
+        return cls([received_ns], [torque], world, None if stamp_ns is None else [stamp_ns],
+                   None if force is None else [force])
+
+    def __len__(self):
+        return len(self.received_ns)
+
+    def select(self, keep):
+        """Return the commands where the boolean sequence ``keep`` is true, in order."""
+        keep = np.asarray(keep, dtype=bool)
+        index = np.flatnonzero(keep)
+        return TorqueCommands(
+            [self.received_ns[i] for i in index], self.torques[keep], self.world[keep],
+            None if self.stamps_ns is None else [self.stamps_ns[i] for i in index],
+            None if self.forces is None else self.forces[keep])
+
+
+class Mailbox:
+    """
+    A thread-safe inbox of command values for a pace, without ROS.
+
+    :meth:`put` from any thread; the pace takes them with :meth:`take` (its
+    ``inbox``) and, in lockstep, blocks in :meth:`wait` (its ``wait``).
+    """
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._items = []
+        self._arrived = threading.Event()
+
+    def put(self, commands):
+        """Queue one command value (e.g. :class:`TorqueCommands`)."""
+        with self._lock:
+            self._items.append(commands)
+            self._arrived.set()
+
+    def take(self):
+        """Return the queued values, oldest first, and forget them."""
+        with self._lock:
+            items, self._items = self._items, []
+            self._arrived.clear()
+        return items
+
+    def wait(self, timeout):
+        """Block until something is queued or ``timeout`` s pass; whether something is."""
+        return self._arrived.wait(timeout)
+
+    def wake(self):
+        """Wake a :meth:`wait` now (stopping)."""
+        self._arrived.set()
