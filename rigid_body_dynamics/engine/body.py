@@ -110,43 +110,77 @@ class Snapshot(NamedTuple):
     odom_only: bool = False    # lockstep's tick state between publish ticks: odom (and clock, TF)
 
 
+#: Up to this many commands are checked one by one in plain Python, more as arrays: numpy's
+#: fixed cost (20-30 us) tripled a lockstep tick's command cost (benchmarks/command_path.py).
+CHECK_ARRAYS_FROM = 8
+
+
 class CheckedTorques:
     """
     Torque commands checked at once, for the body to count and hold in slices.
 
     Made by :meth:`BodySimulation.check`, read by :meth:`BodySimulation.hold`.
-
-    Plain data, read by the body only: the clipped vectors, the running counts of
-    refused, clipped and force-carrying commands before each index, and the newest
-    finite index at or before each. So a flood of N commands costs one check of N
-    vectors, and a slice a few integer operations.
+    Plain data: the clipped vectors, each command's frame, the running counts of
+    refused, clipped and force-carrying commands before each index, and the
+    newest finite index at or before each. So a flood of N commands costs one
+    check of N vectors (as arrays from CHECK_ARRAYS_FROM on), and a slice a few
+    integer operations.
     """
 
     kind = 'torque'
 
     def __init__(self, commands, max_torque):
-        v = commands.torques
-        n = len(v)
-        finite = np.all(np.isfinite(v), axis=1)
-        if max_torque > 0.0:
-            over = finite & np.any(np.abs(v) > max_torque, axis=1)
-            v = np.clip(v, -max_torque, max_torque)
-        else:
-            over = np.zeros(n, dtype=bool)
-        f = commands.forces
-        pushed = finite & np.any((f != 0.0) | ~np.isfinite(f), axis=1) if f is not None \
-            else np.zeros(n, dtype=bool)
         self.received_ns = commands.received_ns
         self.stamps_ns = commands.stamps_ns
-        self.vectors = v.tolist()
-        self.world = commands.world.tolist()
-        # counts of commands before index i, and the newest finite index at or before i
-        self.bad, self.over, self.pushed = (
-            [0] + np.cumsum(mask).tolist() for mask in (~finite, over, pushed))
-        self.newest = np.maximum.accumulate(np.where(finite, np.arange(n), -1)).tolist()
+        self.world_of = commands.world_of
+        check = _check_each if len(commands) < CHECK_ARRAYS_FROM else _check_arrays
+        # the clipped vectors; counts of commands before index i that were refused, clipped,
+        # carried a force; the newest finite index at or before i
+        self.vectors, self.bad, self.over, self.pushed, self.newest = check(commands, max_torque)
 
     def __len__(self):
         return len(self.received_ns)
+
+
+def _check_each(commands, limit):
+    """(vectors, bad, over, pushed, newest) of :class:`CheckedTorques`, one by one in Python."""
+    vectors, bad, over, pushed, newest = [], [0], [0], [0], []
+    forces, last = commands.forces, -1
+    for i, torque in enumerate(commands.torques):
+        v = [float(c) for c in torque]
+        ok = all(math.isfinite(c) for c in v)
+        clip = ok and limit > 0.0 and any(abs(c) > limit for c in v)
+        if clip:
+            v = [min(max(c, -limit), limit) for c in v]
+        f = forces[i] if forces is not None else None
+        push = ok and f is not None and any(not math.isfinite(c) or c != 0.0 for c in f)
+        vectors.append(v)
+        bad.append(bad[-1] + (not ok))
+        over.append(over[-1] + clip)
+        pushed.append(pushed[-1] + push)
+        last = i if ok else last
+        newest.append(last)
+    return vectors, bad, over, pushed, newest
+
+
+def _check_arrays(commands, limit):
+    """As :func:`_check_each`, over (N, 3) arrays at once."""
+    v = np.asarray(commands.torques, dtype=float).reshape(-1, 3)
+    n = len(v)
+    finite = np.all(np.isfinite(v), axis=1)
+    if limit > 0.0:
+        over = finite & np.any(np.abs(v) > limit, axis=1)
+        v = np.clip(v, -limit, limit)
+    else:
+        over = np.zeros(n, dtype=bool)
+    if commands.forces is not None:
+        f = np.asarray(commands.forces, dtype=float).reshape(-1, 3)
+        pushed = finite & np.any((f != 0.0) | ~np.isfinite(f), axis=1)
+    else:
+        pushed = np.zeros(n, dtype=bool)
+    bad, over, pushed = ([0] + np.cumsum(mask).tolist() for mask in (~finite, over, pushed))
+    newest = np.maximum.accumulate(np.where(finite, np.arange(n), -1)).tolist()
+    return v.tolist(), bad, over, pushed, newest
 
 
 class BodySimulation:
@@ -358,7 +392,7 @@ class BodySimulation:
                 events.add('accepted')
                 i = checked.newest[stop - 1]
                 self.command_held = self._make_command(
-                    tuple(checked.vectors[i]), checked.world[i], checked.received_ns[stop - 1],
+                    tuple(checked.vectors[i]), checked.world_of(i), checked.received_ns[stop - 1],
                     None if checked.stamps_ns is None else checked.stamps_ns[i])
             self.events |= events
         return events

@@ -21,49 +21,58 @@ it; the paces do not change. :class:`Mailbox` is an inbox for code without ROS
 
 import threading
 
-import numpy as np
-
 
 class TorqueCommands:
     """
     N torque commands, oldest first (kind ``'torque'``).
 
     ``received_ns``: steady-clock receive times (int ns, non-decreasing);
-    ``torques`` (N, 3) N m, each in the body frame or, where ``world`` is true,
-    in the world frame (``world``: one bool for all, or N); ``stamps_ns``: the
-    messages' header stamps (int ns) or None; ``forces`` (N, 3) N or None (a
-    non-zero force is ignored and counted: the body does not translate).
-    Non-finite values are kept: the body refuses and counts them.
+    ``torques`` (N, 3) array-like, N m, each in the body frame or, where ``world``
+    is true, in the world frame (``world``: one bool for all, or N); ``stamps_ns``:
+    the messages' header stamps (int ns) or None; ``forces`` (N, 3) array-like, N,
+    or None (a non-zero force is ignored and counted: the body does not translate).
+    Non-finite values are kept: the body refuses and counts them. Nothing is
+    copied or converted here (a controller's one command per tick stays cheap);
+    the body's check reads the values.
     """
 
     kind = 'torque'
     __slots__ = ('received_ns', 'torques', 'world', 'stamps_ns', 'forces')
 
     def __init__(self, received_ns, torques, world=False, stamps_ns=None, forces=None):
-        self.received_ns = [int(t) for t in received_ns]
-        n = len(self.received_ns)
-        self.torques = np.asarray(torques, dtype=float).reshape(n, 3)
-        self.world = np.broadcast_to(np.asarray(world, dtype=bool), (n,))
-        self.stamps_ns = None if stamps_ns is None else [int(s) for s in stamps_ns]
-        self.forces = None if forces is None else np.asarray(forces, dtype=float).reshape(n, 3)
+        self.received_ns = received_ns
+        self.torques = torques
+        self.world = world
+        self.stamps_ns = stamps_ns
+        self.forces = forces
+        n = len(received_ns)
+        if len(torques) != n or (forces is not None and len(forces) != n) or \
+                (stamps_ns is not None and len(stamps_ns) != n):
+            raise ValueError(f'{n} receive times, {len(torques)} torques: lengths differ')
 
     @classmethod
     def one(cls, torque, world, received_ns, stamp_ns=None, force=None):
         """Return a single command: ``torque`` (3,) N m, body or ``world`` frame."""
-        return cls([received_ns], [torque], world, None if stamp_ns is None else [stamp_ns],
-                   None if force is None else [force])
+        return cls((int(received_ns),), (torque,), bool(world),
+                   None if stamp_ns is None else (int(stamp_ns),),
+                   None if force is None else (force,))
 
     def __len__(self):
         return len(self.received_ns)
 
+    def world_of(self, i):
+        """Return whether command ``i`` is in the world frame."""
+        return bool(self.world if isinstance(self.world, bool) else self.world[i])
+
     def select(self, keep):
         """Return the commands where the boolean sequence ``keep`` is true, in order."""
-        keep = np.asarray(keep, dtype=bool)
-        index = np.flatnonzero(keep)
-        return TorqueCommands(
-            [self.received_ns[i] for i in index], self.torques[keep], self.world[keep],
-            None if self.stamps_ns is None else [self.stamps_ns[i] for i in index],
-            None if self.forces is None else self.forces[keep])
+        index = [i for i, k in enumerate(keep) if k]
+
+        def pick(values):
+            return None if values is None else [values[i] for i in index]
+        world = self.world if isinstance(self.world, bool) else pick(self.world)
+        return TorqueCommands(pick(self.received_ns), pick(self.torques), world,
+                              pick(self.stamps_ns), pick(self.forces))
 
 
 class Mailbox:

@@ -81,7 +81,7 @@ class Lockstep(Pace):
                     body.reject('stale', fresh.count(False))
                     value = value.select(fresh)
             if len(value):
-                taken.append((body.check(value), 0))
+                taken.append([body.check(value), 0])
         return taken
 
     def due(self, outbox):

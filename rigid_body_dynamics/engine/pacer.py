@@ -205,47 +205,62 @@ class Pace:
         """Integrate up to step ``due_steps``, each with the commands newest at its deadline."""
         body = self.body
         pending = self._take()
-        coming = self._next_arrival(pending)
+        coming = self._next_arrival(pending) if pending else math.inf
         # (self.deadline(step), inlined: this loop runs at every step of every body)
         anchor_ns, anchor_steps, period = self.anchor_ns, self.anchor_steps, body.dt_ns / self.rtf
         for step in range(body.steps + 1, due_steps + 1):
             at = anchor_ns + int((step - anchor_steps) * period)
             if coming <= at:
-                pending = self._hold_until(pending, at)
-                coming = self._next_arrival(pending)
+                coming = self._hold_until(pending, at)
             rest = due_steps - step + 1
             if not pending and rest > 1 and body.advance_free(rest, at, outbox):
                 break        # the rest torque-free and no command to come in between: at once
             body.advance(at, outbox)
-        self._hold_until(pending, math.inf)
+        if pending:
+            self._hold_until(pending, math.inf)
 
     def _hold_until(self, pending, at_ns):
-        """Hold the commands received by ``at_ns``; the [checked, next index] still to come."""
-        body, left = self.body, []
-        for checked, i in pending:
-            received, n = checked.received_ns, len(checked)
-            j = i
+        """
+        Hold the commands of ``pending`` received by ``at_ns``.
+
+        ``pending``: [checked value, index of its next command] entries, updated in
+        place (finished ones removed). Returns the next receive time still to come
+        (int ns), or inf.
+        """
+        hold, coming, k = self.body.hold, math.inf, 0
+        while k < len(pending):
+            entry = pending[k]
+            checked, i = entry
+            received = checked.received_ns
+            n, j = len(received), i
             while j < n and received[j] <= at_ns:
                 j += 1
             if j > i:
-                body.hold(checked, i, j)
-            if j < n:
-                left.append((checked, j))
-        return left
+                hold(checked, i, j)
+            if j == n:
+                del pending[k]
+                continue
+            entry[1] = j
+            if received[j] < coming:
+                coming = received[j]
+            k += 1
+        return coming
 
     @staticmethod
     def _next_arrival(pending):
-        """Return the earliest receive time (int ns) still to hold, or inf."""
-        return min((checked.received_ns[i] for checked, i in pending), default=math.inf)
+        """Return the earliest receive time (int ns) still to hold (``pending`` not empty)."""
+        return min(checked.received_ns[i] for checked, i in pending)
 
     def _hold_all(self):
         """Hold every pending command at once (no step due, or as fast as possible)."""
-        self._hold_until(self._take(), math.inf)
+        pending = self._take()
+        if pending:
+            self._hold_until(pending, math.inf)
 
     def _take(self):
-        """Take the inbox's command values, checked by the body: [(checked, 0), ...]."""
+        """Take the inbox's command values, checked by the body: [[checked, 0], ...]."""
         body = self.body
-        return [(body.check(value), 0) for value in self.inbox() if len(value)]
+        return [[body.check(value), 0] for value in self.inbox() if len(value)]
 
     def _next_target(self):
         """Return the step the next wake is for: the next that publishes, or COMMAND_LOOK s on."""
