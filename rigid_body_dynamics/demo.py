@@ -22,8 +22,9 @@ import time
 import numpy as np
 
 from .physics import FreeRigidBody, INTEGRATORS, presets, quaternions, simulate
-from .physics.analysis import analyse, quantity_lines, Trajectory
+from .physics.analysis import analyse, Trajectory
 from .physics.control import QuaternionPD, settling_time
+from .physics.findings_render import text_lines
 
 #: The closed-loop scene: 30 degrees about x from rest, wn 2 rad/s, zeta 0.7, 100 Hz, 10 s.
 SLEW = {'target': (math.sin(math.radians(15.0)), 0.0, 0.0, math.cos(math.radians(15.0))),
@@ -56,35 +57,11 @@ def findings(statuses):
     """
     Lines from the analyzer's newest statuses (name -> (level, message, values)).
 
-    The values are read back by key into the analysis' quantities and
-    printed with the same formatter as the offline analysis.
+    The values are read back into the analysis' Findings (by the module that wrote
+    them) and printed with the same renderer as the offline analysis.
     """
     from .ros import diagnostics
-    lines = []
-    pre = statuses.get('precession')
-    if pre:
-        v = pre[2]
-        axis = next((k.split(' about L')[0].rsplit(' ', 1)[1] for k in v
-                     if k.startswith('mean precession of axis')), None)
-        for label, key, unit in (('body precession Omega (rad/s)', 'body rate', 'rad/s'),
-                                 ('lab precession |L|/I_perp (rad/s)', 'lab rate', 'rad/s'),
-                                 ('period of omega (s)', 'omega period', 's'),
-                                 (f'mean precession of axis {axis} (rad/s)',
-                                  f'mean precession of axis {axis} about L', 'rad/s')):
-            lines += quantity_lines(label, diagnostics.quantity_from(v, key, unit))
-    stab = statuses.get('stability')
-    if stab:
-        lines.append(f'  stability: {stab[1]}')
-        for label, key, unit in (('growth rate (1/s)', 'growth rate', '1/s'),
-                                 ('flip interval (s)', 'flip interval', 's')):
-            lines += quantity_lines(label, diagnostics.quantity_from(stab[2], key, unit))
-    cons = statuses.get('conservation')
-    if cons:
-        v = cons[2]
-        drift = ', '.join(f'{k.split(" since")[0]} {float(v[k]):.1e}' for k in v
-                          if 'since baseline' in k)
-        lines.append(f'  conservation: {cons[1]}' + (f' ({drift})' if drift else ''))
-    return lines
+    return text_lines(diagnostics.findings_from(statuses))[1:]
 
 
 def run_nodes(preset, integrator, rate):

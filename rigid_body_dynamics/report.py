@@ -32,6 +32,7 @@ from .bags import BagError, BagWriter, INERTIA, ODOMETRY, read_trajectory, WRENC
 from .physics import estimators, INTEGRATORS, momentum_sphere, poinsot, presets, quaternions
 from .physics import simulate
 from .physics.analysis import analyse, Trajectory
+from .physics.findings_render import table_rows
 from .physics.sensors import allan_deviation, GyroErrors, GyroModel
 
 
@@ -286,43 +287,10 @@ def make_report(run, out_dir, gyro=None):
                             {'omega': w[:, mid], 'flips': crossings})
     if gyro is not None:
         figures['allan'] = allan_figure(*gyro, out_dir)
-    rows = findings_rows(found)
+    rows = table_rows(found)
     interactive = report_page.write(out_dir, report_page.views(moments, t, q, w))
     _write_html(run, out_dir, figures, rows, interactive)
     return figures, rows
-
-
-def findings_rows(found):
-    """Table rows (quantity, measured, theory) of the analysis' findings, as text."""
-    def text(x, fmt='.10g'):
-        return 'n/a' if x is None else format(x, fmt)
-
-    def qty(label, q):
-        if q is None:
-            return []
-        measured = text(q.measured) if q.measured is not None else f'not available: {q.why}'
-        return [(label, measured, text(q.theory))]
-    c, p, s = found.conservation, found.precession, found.stability
-    rows = []
-    if c.mode == 'free motion':
-        rows += [('largest energy drift (rel.)', f'{c.energy_drift:.2e}', '0'),
-                 ('largest |L| drift (rel.)', f'{c.momentum_drift:.2e}', '0'),
-                 ('largest L direction drift (rad)', f'{c.direction_drift:.2e}', '0')]
-    elif c.mode == 'balance laws':
-        rows += [('work-energy residual (rel.)', f'{c.energy_residual:.2e}', '0'),
-                 ('impulse-momentum residual (rel.)', f'{c.momentum_residual:.2e}', '0')]
-    rows += qty('body precession rate (rad/s)', p.body_rate)
-    rows += qty('lab precession rate (rad/s)', p.lab_rate)
-    rows += qty('period of omega (s)', p.omega_period)
-    if p.circled_axis is not None:
-        rows += qty(f'mean precession of axis {p.circled_axis + 1} about L (rad/s)',
-                    p.mean_precession)
-    if s.axis is not None:
-        rows.append(('stability of the spin', s.kind, f'axis {s.axis + 1}'))
-    rows += qty('growth rate (1/s)', s.growth_rate)
-    rows += qty('flip interval (s)', s.flip_interval)
-    rows += qty('wobble frequency (rad/s)', s.wobble_frequency)
-    return rows
 
 
 def _write_html(run, out_dir, figures, rows, interactive=''):

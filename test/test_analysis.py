@@ -192,3 +192,49 @@ def test_rigid_body_analyze_refuses_a_zero_tolerance(capsys):
         analyze.main(['any.mcap', '--rate-tolerance', '0'])
     assert stop.value.code == 2
     assert 'the rate tolerance must be a finite number > 0, got 0.0' in capsys.readouterr().err
+
+
+def _cases():
+    """Return findings of every kind: a top, a racket (flips, and under torque), a short window."""
+    out = {}
+    for name, duration, torque in (('symmetric_top', 10.0, None), ('tennis_racket', 50.0, None),
+                                   ('tennis_racket', 5.0, (0.0, 0.0, 0.05)),
+                                   ('tennis_racket', 0.05, None)):
+        body = presets.get(name)
+        run = simulate(body.moments, body.omega0, body.q0, duration=duration, dt=1e-2,
+                       torque=torque)
+        out[f'{name} {duration} s torque {torque}'] = analyse(Trajectory.from_simulation(run))
+    run = simulate((1.0, 2.0, 3.0), (2.0, 0.1, 0.1), (0.0, 0.0, 0.0, 1.0), duration=30.0,
+                   dt=1e-2)
+    out['stable about the minor axis'] = analyse(Trajectory.from_simulation(run))
+    return out
+
+
+def test_the_analyzers_diagnostics_read_back_into_the_same_findings():
+    """
+    The one rendering to key/values and its reader agree (the demo prints what it reads).
+
+    Through the real path: DiagnosticStatus with string values, read back by key into
+    Findings, printed by the one text renderer: the same lines as the findings printed
+    directly, for every kind of finding. A key renamed on one side only fails here.
+    """
+    from rigid_body_dynamics.physics.findings_render import table_rows, text_lines
+    from rigid_body_dynamics.ros import diagnostics
+    from rigid_body_dynamics.ros.conversions import status_values
+    seen = set()
+    for case, found in _cases().items():
+        statuses = diagnostics.statuses(found, 'attitude_analyzer', 'hw', 7)
+        received = {st.name.split(': ', 1)[1]: (st.level, st.message, status_values(st))
+                    for st in statuses}
+        for _level, _message, values in received.values():
+            seen |= set(values)
+        back = diagnostics.findings_from(received)
+        assert text_lines(back)[1:] == text_lines(found)[1:], case
+        assert table_rows(back) == table_rows(found), case
+    # every quantity of the reader's table was written by some case, with its unit
+    for key in ('body rate, measured (rad/s)', 'lab rate, measured (rad/s)',
+                'omega period, measured (s)',
+                'mean precession of axis 3 about L, measured (rad/s)',
+                'growth rate, measured (1/s)', 'flip interval, measured (s)',
+                'wobble frequency, measured (rad/s)', 'circled axis'):
+        assert key in seen, key

@@ -48,7 +48,7 @@ def test_symmetric_report_has_precession_against_theory(tmp_path):
     data = figures['precession'][1]
     np.testing.assert_allclose(data['measured'], data['theory'], atol=1e-12)
     measured = {a: float(b) for a, b, _ in rows if 'precession' in a}
-    assert measured['body precession rate (rad/s)'] == pytest.approx(1.0, rel=1e-12)
+    assert measured['body precession Omega (rad/s)'] == pytest.approx(1.0, rel=1e-12)
 
 
 def test_allan_figure_of_the_simulated_gyro_shows_its_n_and_k(tmp_path, capsys):

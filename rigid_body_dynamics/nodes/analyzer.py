@@ -363,9 +363,7 @@ class AttitudeAnalyzer(Node):
                                ('precession/lab_rate', pre.lab_rate)):
                 if qty is not None and qty.measured is not None:
                     self._publish(topic, qty.measured)
-            statuses += [diagnostics.conservation(found.conservation, name, hw, origin),
-                         diagnostics.precession(found.precession, name, hw),
-                         diagnostics.stability(found.stability, name, hw)]
+            statuses += diagnostics.statuses(found, name, hw, origin)
         array = DiagnosticArray(status=statuses)
         array.header.stamp = self.get_clock().now().to_msg()
         self._pub_diag.publish(array)

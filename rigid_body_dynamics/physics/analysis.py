@@ -1,6 +1,10 @@
 """
 The one analysis of an attitude trajectory: what the motion does, and whether physics holds.
 
+This module computes; the findings' data model is :mod:`.findings`, what counts
+as agreement :mod:`.tolerances`, and their text, table and diagnostics forms
+:mod:`.findings_render` (their names are re-exported here).
+
 Every door uses it: the ``attitude_analyzer`` node (live topics), the report,
 the demo and ``rigid_body_analyze`` (bags). A :class:`Trajectory` holds the
 samples (integer-ns stamps relative to a stated origin, so no precision is
@@ -21,10 +25,15 @@ import math
 import numpy as np
 
 from . import equations, estimators, theory
+from .findings import (ConservationFindings, ERROR, Findings, OK, PrecessionFindings, Quantity,
+                       StabilityFindings, UNAVAILABLE, WARN)
+from .findings_render import quantity_lines
 from .inertia import as_inertia
+from .tolerances import compare, level, Tolerances, unavailable, worst
 
-OK, WARN, ERROR, UNAVAILABLE = 'OK', 'WARN', 'ERROR', 'unavailable'
-_RANK = {UNAVAILABLE: -1, OK: 0, WARN: 1, ERROR: 2}
+__all__ = ['analyse', 'compare', 'ConservationFindings', 'ERROR', 'Findings', 'OK',
+           'PrecessionFindings', 'Quantity', 'quantity_lines', 'StabilityFindings', 'Tolerances',
+           'Trajectory', 'UNAVAILABLE', 'unavailable', 'WARN']
 
 
 @dataclass(frozen=True)
@@ -124,276 +133,6 @@ class Trajectory:
                 body.to_principal(self.omega), body.to_principal(self.torque))
 
 
-@dataclass(frozen=True)
-class Tolerances:
-    """
-    What counts as agreement. Relative unless said; WARN above, ERROR above 100 times.
-
-    ``energy``, ``momentum``: free-motion drift of T, and of |L| and the L
-    direction (rad). ``balance``: work-energy and impulse-momentum residuals
-    under torque (sampled torque costs an O(dt) quadrature error at each
-    change). ``rate``: measured against predicted rates and periods of the
-    free motion. ``growth``: the measured growth rate near the intermediate
-    axis against the linearised prediction (finite amplitudes differ by
-    about 1e-4). ``min_samples``: fewer samples give no estimate.
-    """
-
-    energy: float = 1e-6
-    momentum: float = 1e-6
-    balance: float = 1e-2
-    rate: float = 1e-6
-    growth: float = 1e-2
-    min_samples: int = 20
-
-    def __post_init__(self):
-        """Refuse a tolerance that is not a positive number: 0 switched its check off."""
-        for name in ('energy', 'momentum', 'balance', 'rate', 'growth'):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                    or not math.isfinite(value) or value <= 0.0:
-                raise ValueError(f'the {name} tolerance must be a finite number > 0, got '
-                                 f'{value!r}')
-        if isinstance(self.min_samples, bool) or not isinstance(self.min_samples, int) \
-                or self.min_samples < 2:
-            raise ValueError(f'min_samples must be an integer >= 2, got {self.min_samples!r}')
-
-
-@dataclass(frozen=True)
-class Quantity:
-    """
-    A measured number beside its prediction, and whether they agree.
-
-    ``measured`` and ``theory`` are floats or None (None: not available,
-    ``why`` says why); ``status`` is OK / WARN / ERROR against ``tolerance``
-    (relative), or ``unavailable``; ``unit`` as in the labels.
-    """
-
-    measured: object
-    theory: object
-    status: str
-    unit: str = ''
-    tolerance: float = math.nan
-    why: str = ''
-
-    @property
-    def relative_error(self):
-        """|measured - theory| / |theory|, or None when either is missing or theory is 0."""
-        if self.measured is None or self.theory is None or not self.theory:
-            return None
-        return abs(self.measured - self.theory) / abs(self.theory)
-
-
-def _level(worst):
-    """Status of a ratio error / tolerance."""
-    return OK if worst <= 1.0 else (WARN if worst <= 100.0 else ERROR)
-
-
-def compare(measured, predicted, tolerance, unit=''):
-    """
-    Make a :class:`Quantity` of a measurement and its prediction at a relative tolerance.
-
-    ``tolerance`` must be > 0 (ValueError). Without a measurement or without a
-    prediction the quantity is ``unavailable``, saying which is missing; a
-    prediction of exactly 0 has no relative scale, so the measurement is
-    compared on an absolute one: ``|measured|`` against ``tolerance`` (in ``unit``).
-    """
-    if not tolerance > 0.0:
-        raise ValueError(f'a tolerance must be > 0, got {tolerance!r}')
-    measured = None if measured is None or not math.isfinite(measured) else float(measured)
-    predicted = None if predicted is None or not math.isfinite(predicted) else float(predicted)
-    if measured is None:
-        return Quantity(None, predicted, UNAVAILABLE, unit, tolerance, 'no measurement')
-    if predicted is None:
-        return Quantity(measured, None, UNAVAILABLE, unit, tolerance, 'no prediction')
-    if predicted == 0.0:
-        return Quantity(measured, predicted, _level(abs(measured) / tolerance), unit, tolerance,
-                        'compared on an absolute scale: the prediction is 0')
-    rel = abs(measured - predicted) / abs(predicted)
-    return Quantity(measured, predicted, _level(rel / tolerance), unit, tolerance)
-
-
-def unavailable(why, predicted=None, unit=''):
-    """Make a :class:`Quantity` without a measurement, saying why (a prediction may exist)."""
-    predicted = None if predicted is None or not math.isfinite(predicted) else float(predicted)
-    return Quantity(None, predicted, UNAVAILABLE, unit, math.nan, why)
-
-
-def _worst(*statuses):
-    known = [s for s in statuses if s != UNAVAILABLE]
-    return max(known, key=_RANK.get) if known else UNAVAILABLE
-
-
-@dataclass(frozen=True)
-class ConservationFindings:
-    """
-    Free motion: largest drift from the baseline; under torque: balance-law residuals.
-
-    ``mode``: 'free motion' or 'balance laws' (torque in the window) or
-    'unavailable'. Free: ``energy_drift`` |T/T0 - 1|, ``momentum_drift``
-    ||L|/|L0| - 1|, ``direction_drift`` angle(L_w, L_w0) rad, the largest over
-    the samples; ``baseline_ns`` the baseline's stamp (ns since origin).
-    Balance: ``energy_residual``, ``momentum_residual`` (estimators.balance) and
-    the ``work`` (J) over the window.
-    """
-
-    status: str
-    message: str
-    mode: str
-    energy_drift: object = None
-    momentum_drift: object = None
-    direction_drift: object = None
-    baseline_ns: object = None
-    energy_residual: object = None
-    momentum_residual: object = None
-    work: object = None
-    energy_tolerance: float = math.nan
-    momentum_tolerance: float = math.nan
-
-
-@dataclass(frozen=True)
-class PrecessionFindings:
-    """
-    Precession of the free motion.
-
-    ``kind``: 'axisymmetric', 'asymmetric', 'spherical', 'principal spin' or
-    'unavailable'. Axisymmetric: ``body_rate`` (omega about the symmetry axis
-    in the body frame, the seed's Omega), ``lab_rate`` (the symmetry axis
-    about L), the cone angles (rad). Asymmetric: ``omega_period`` (s) and
-    ``mean_precession`` of the ``circled_axis`` about L (rad/s), measured over
-    a whole number of periods of omega.
-    """
-
-    status: str
-    message: str
-    kind: str
-    body_rate: Quantity = None
-    lab_rate: Quantity = None
-    omega_period: Quantity = None
-    mean_precession: Quantity = None
-    cones: object = None
-    symmetry_axis: object = None
-    circled_axis: object = None
-    polhode_family: str = ''
-
-
-@dataclass(frozen=True)
-class StabilityFindings:
-    """
-    The spin about the principal axis the motion stays nearest over the window.
-
-    ``axis`` (0-based), ``kind`` ('stable', 'unstable', 'marginal', 'rest'),
-    ``family`` and ``separatrix_distance`` of the polhode; stable:
-    ``wobble_frequency`` (rad/s, 2 pi / period of omega: the same frequency as
-    the precession's body rate for a top); unstable: ``growth_rate`` (1/s)
-    and ``flip_interval`` (s). Status WARN while unstable.
-    """
-
-    status: str
-    message: str
-    axis: object = None
-    kind: str = ''
-    family: str = ''
-    separatrix_distance: float = math.nan
-    wobble_frequency: Quantity = None
-    growth_rate: Quantity = None
-    flip_interval: Quantity = None
-
-
-@dataclass(frozen=True)
-class Findings:
-    """Everything :func:`analyse` says about a trajectory."""
-
-    samples: int
-    span: float
-    conservation: ConservationFindings
-    precession: PrecessionFindings
-    stability: StabilityFindings
-    kinetic_energy: object = None
-    angular_momentum_norm: object = None
-    under_torque: bool = False
-
-    def to_dict(self):
-        """Return the JSON form (``rigid_body_analyze --json``): numbers, None where n/a."""
-        def num(x):
-            return None if x is None or not math.isfinite(x) else float(x)
-
-        def quantity(prefix, qty):
-            if qty is None:
-                return {prefix: None, f'{prefix}_theory': None}
-            return {prefix: num(qty.measured), f'{prefix}_theory': num(qty.theory)}
-        c, p, s = self.conservation, self.precession, self.stability
-        out = {'samples': self.samples, 'span_s': self.span,
-               'kinetic_energy': num(self.kinetic_energy),
-               'angular_momentum_norm': num(self.angular_momentum_norm),
-               'conservation': {'status': c.status, 'mode': c.mode,
-                                'energy_drift': num(c.energy_drift),
-                                'momentum_drift': num(c.momentum_drift),
-                                'direction_drift': num(c.direction_drift),
-                                'energy_residual': num(c.energy_residual),
-                                'momentum_residual': num(c.momentum_residual),
-                                'message': c.message},
-               'precession': {'status': p.status, 'kind': p.kind, 'message': p.message,
-                              **quantity('body_rate', p.body_rate),
-                              **quantity('lab_rate', p.lab_rate if p.lab_rate is not None
-                                         else p.mean_precession),
-                              **quantity('omega_period', p.omega_period)},
-               'stability': {'status': s.status, 'message': s.message,
-                             'axis': None if s.axis is None else int(s.axis) + 1,
-                             'class': s.kind or None, 'family': s.family or None,
-                             'separatrix_distance': num(s.separatrix_distance),
-                             **quantity('growth_rate', s.growth_rate),
-                             **quantity('flip_interval', s.flip_interval),
-                             **quantity('wobble_frequency', s.wobble_frequency)}}
-        return out
-
-    def lines(self):
-        """Readable lines: each measured number beside theory, statuses and reasons."""
-        c, p, s = self.conservation, self.precession, self.stability
-        out = [f'  {self.samples} samples over {self.span:.6g} s']
-        if p.kind == 'axisymmetric':
-            out += quantity_lines('body precession Omega (rad/s)', p.body_rate)
-            out += quantity_lines('lab precession |L|/I_perp (rad/s)', p.lab_rate)
-        elif p.kind == 'asymmetric':
-            out += quantity_lines('period of omega (s)', p.omega_period)
-            if p.circled_axis is not None:
-                out += quantity_lines(f'mean precession of axis {p.circled_axis + 1} (rad/s)',
-                                      p.mean_precession)
-        else:
-            out.append(f'  precession: {p.message}')
-        out.append(f'  stability: {s.message}')
-        out += quantity_lines('growth rate (1/s)', s.growth_rate)
-        out += quantity_lines('flip interval (s)', s.flip_interval)
-        if p.body_rate is None:            # a top's wobble is its Omega, printed above
-            out += quantity_lines('wobble frequency (rad/s)', s.wobble_frequency)
-        out.append(conservation_line(c))
-        return out
-
-
-def quantity_lines(label, qty):
-    """One aligned line for a :class:`Quantity` (none when there is nothing to say)."""
-    if qty is None or (qty.measured is None and qty.theory is None):
-        return []
-    if qty.measured is None:
-        theory_text = '' if qty.theory is None else f' (theory {qty.theory:.10g})'
-        return [f'  {label:<36} not available: {qty.why}{theory_text}']
-    if qty.theory is None:
-        return [f'  {label:<36} {qty.measured:>+.10f}']
-    rel = qty.relative_error
-    rel_text = '' if rel is None else f'  (rel. {rel:.1e}, {qty.status})'
-    return [f'  {label:<36} {qty.measured:>+.10f}  theory {qty.theory:>+.10f}{rel_text}']
-
-
-def conservation_line(c):
-    """One line for :class:`ConservationFindings`."""
-    if c.mode == 'free motion':
-        return (f'  conservation: {c.message} (energy drift {c.energy_drift:.1e}, |L| drift '
-                f'{c.momentum_drift:.1e}, L direction drift {c.direction_drift:.1e} rad)')
-    if c.mode == 'balance laws':
-        return (f'  conservation under torque: {c.message} (work-energy residual '
-                f'{c.energy_residual:.1e}, impulse-momentum {c.momentum_residual:.1e})')
-    return f'  conservation: {c.message}'
-
-
 def analyse(trajectory, baseline=None, tolerances=Tolerances()):
     """
     Analyse ``trajectory``: conservation, precession, stability against theory.
@@ -439,25 +178,24 @@ def analyse(trajectory, baseline=None, tolerances=Tolerances()):
 def _conservation(t, q, w, tau, moments, baseline, under_torque, tol):
     if under_torque:
         bal = estimators.balance(t, q, w, tau, moments)
-        worst = max(bal.energy, bal.momentum) / tol.balance if tol.balance else 0.0
-        level = _level(worst)
-        message = ('balance laws hold under torque' if level == OK else
+        ratio = max(bal.energy, bal.momentum) / tol.balance
+        status = level(ratio)
+        message = ('balance laws hold under torque' if status == OK else
                    f'{"energy" if bal.energy >= bal.momentum else "angular momentum"} balance '
-                   f'off by {worst:.3g} x tolerance')
-        return ConservationFindings(level, message, 'balance laws', energy_residual=bal.energy,
+                   f'off by {ratio:.3g} x tolerance')
+        return ConservationFindings(status, message, 'balance laws', energy_residual=bal.energy,
                                     momentum_residual=bal.momentum, work=bal.work,
                                     energy_tolerance=tol.balance, momentum_tolerance=tol.balance)
     b_t, b_q, b_w = baseline
     energy, norm, direction = estimators.drift_series(moments, q, w, b_q, b_w)
     e_err, l_err, d_err = float(energy.max()), float(norm.max()), float(direction.max())
-    worst_e = e_err / tol.energy if tol.energy else 0.0
-    worst_l = max(l_err, d_err) / tol.momentum if tol.momentum else 0.0
-    worst = max(worst_e, worst_l)
-    level = _level(worst)
-    message = 'conserved' if level == OK else (
-        f'{"energy" if worst_e >= worst_l else "angular momentum"} off by {worst:.3g} x '
+    ratio_e, ratio_l = e_err / tol.energy, max(l_err, d_err) / tol.momentum
+    ratio = max(ratio_e, ratio_l)
+    status = level(ratio)
+    message = 'conserved' if status == OK else (
+        f'{"energy" if ratio_e >= ratio_l else "angular momentum"} off by {ratio:.3g} x '
         'tolerance')
-    return ConservationFindings(level, message, 'free motion', e_err, l_err, d_err, int(b_t),
+    return ConservationFindings(status, message, 'free motion', e_err, l_err, d_err, int(b_t),
                                 energy_tolerance=tol.energy, momentum_tolerance=tol.momentum)
 
 
@@ -483,7 +221,7 @@ def _precession(t, q, w, moments, inertia, tol):
                    'rad/s')
     lab = compare(estimators.lab_precession_rate(t, q, w, moments, axis).rate, lab_theory,
                   tol.rate, 'rad/s')
-    status = _worst(body.status, lab.status)
+    status = worst(body.status, lab.status)
     message = (f'body {body.measured:.6g} rad/s (theory {body_theory:.6g}), '
                f'lab {lab.measured:.6g} rad/s (theory {lab_theory:.6g})')
     if status != OK:
@@ -520,7 +258,7 @@ def _asymmetric_precession(t, q, w, moments, tol):
     rate, periods = estimators.mean_rate_over_periods(
         t, estimators.lab_precession_angle(q, w, moments, axis), period)
     mean = compare(rate, mean_theory, tol.rate, 'rad/s')
-    status = _worst(omega_period.status, mean.status)
+    status = worst(omega_period.status, mean.status)
     measured = 'n/a' if omega_period.measured is None else f'{omega_period.measured:.6g}'
     message = (f'omega period {measured} s (theory {period:.6g}), axis {axis + 1} precesses '
                f'about L at {rate:.6g} rad/s '
@@ -550,7 +288,8 @@ def _stability(t, w, moments, inertia, tol, precession=None, torque_why=None):
         flip = theory.flip_interval(moments, omega)
         message = f'spin about axis {st.axis + 1} is unstable: growth rate {st.rate:.6g} 1/s'
         if torque_why:
-            return StabilityFindings(WARN, message, growth_rate=unavailable(torque_why, st.rate),
+            return StabilityFindings(WARN, message,
+                                     growth_rate=unavailable(torque_why, st.rate, '1/s'),
                                      flip_interval=unavailable(torque_why, flip, 's'), **common)
         try:
             growth = compare(estimators.separatrix_growth_rate(t, w, moments), st.rate,

@@ -2,117 +2,45 @@
 Findings of the analysis -> diagnostic_msgs/DiagnosticStatus (REP 107) for attitude_analyzer.
 
 Status names are ``<node>: conservation``, ``<node>: precession`` and
-``<node>: stability``; the keys are an interface users parse, listed in the
-manual's attitude_analyzer page. A measured quantity gives three keys,
-``<label>, measured (<unit>)``, ``<label>, theory (<unit>)`` and
-``<label> error (rel.)``; one that is not available gives
-``<label>, measured (<unit>)`` = ``not available: <why>``.
+``<node>: stability``; their values are
+:func:`~rigid_body_dynamics.physics.findings_render.key_values` (the one rendering
+of findings to key/values, whose keys the manual's attitude_analyzer page lists),
+and :func:`findings_from` reads them back with
+:func:`~rigid_body_dynamics.physics.findings_render.from_key_values`.
 ``unavailable`` findings are level OK with the reason as the message.
 """
 
 from diagnostic_msgs.msg import DiagnosticStatus
 
 from .conversions import status
-from ..physics import analysis
+from ..physics import findings, findings_render
 
-LEVELS = {analysis.OK: DiagnosticStatus.OK, analysis.WARN: DiagnosticStatus.WARN,
-          analysis.ERROR: DiagnosticStatus.ERROR, analysis.UNAVAILABLE: DiagnosticStatus.OK}
-
-
-def quantity(label, qty):
-    """Key-value pairs of one :class:`~rigid_body_dynamics.physics.analysis.Quantity`."""
-    if qty is None:
-        return []
-    unit = f' ({qty.unit})' if qty.unit else ''
-    out = []
-    if qty.measured is None:
-        out.append((f'{label}, measured{unit}', f'not available: {qty.why}'))
-    else:
-        out.append((f'{label}, measured{unit}', qty.measured))
-    if qty.theory is not None:
-        out.append((f'{label}, theory{unit}', qty.theory))
-    if qty.relative_error is not None:
-        out += [(f'{label} error (rel.)', qty.relative_error), (f'{label} status', qty.status)]
-    return out
+LEVELS = {findings.OK: DiagnosticStatus.OK, findings.WARN: DiagnosticStatus.WARN,
+          findings.ERROR: DiagnosticStatus.ERROR, findings.UNAVAILABLE: DiagnosticStatus.OK}
+#: The three checks, in the order they are published.
+CHECKS = ('conservation', 'precession', 'stability')
 
 
-def conservation(found, name, hardware_id, origin_ns):
-    """Status ``<name>: conservation``; ``origin_ns`` turns the baseline stamp into seconds."""
-    values = []
-    if found.mode == 'free motion':
-        values = [('mode', 'free motion'),
-                  ('baseline stamp (s)', (origin_ns + found.baseline_ns) * 1e-9),
-                  ('energy drift since baseline (rel.)', found.energy_drift),
-                  ('|L| drift since baseline (rel.)', found.momentum_drift),
-                  ('L direction drift since baseline (rad)', found.direction_drift)]
-    elif found.mode == 'balance laws':
-        values = [('mode', 'balance laws (torque applied in the window)'),
-                  ('work-energy residual (rel.)', found.energy_residual),
-                  ('impulse-momentum residual (rel.)', found.momentum_residual),
-                  ('work over the window (J)', found.work)]
-    if found.mode != analysis.UNAVAILABLE:
-        values += [('energy tolerance', found.energy_tolerance),
-                   ('momentum tolerance', found.momentum_tolerance)]
-    return status(f'{name}: conservation', LEVELS[found.status], found.message, values,
-                  hardware_id)
-
-
-def precession(found, name, hardware_id):
-    """Status ``<name>: precession``."""
-    values = []
-    if found.kind == 'axisymmetric':
-        values += quantity('body rate', found.body_rate) + quantity('lab rate', found.lab_rate)
-        values += [('body cone half-angle (rad)', found.cones.body),
-                   ('lab cone half-angle (rad)', found.cones.lab),
-                   ('nutation angle (rad)', found.cones.nutation)]
-    elif found.kind == 'asymmetric':
-        values.append(('polhode family', found.polhode_family))
-        values += quantity('omega period', found.omega_period)
-        if found.circled_axis is not None:
-            values += quantity(f'mean precession of axis {found.circled_axis + 1} about L',
-                               found.mean_precession)
-    elif found.polhode_family:
-        values.append(('polhode family', found.polhode_family))
-    return status(f'{name}: precession', LEVELS[found.status], found.message, values,
-                  hardware_id)
-
-
-def stability(found, name, hardware_id):
-    """Status ``<name>: stability``."""
-    values = []
-    if found.axis is not None:
-        values = [('nearest principal axis', found.axis + 1), ('class', found.kind),
-                  ('polhode family', found.family),
-                  ('separatrix distance (S/G^2)', found.separatrix_distance)]
-        values += quantity('growth rate', found.growth_rate)
-        values += quantity('flip interval', found.flip_interval)
-        if found.wobble_frequency is not None:
-            # the theory value kept under its old key too
-            values.append(('wobble frequency (rad/s)', found.wobble_frequency.theory))
-            values += quantity('wobble frequency', found.wobble_frequency)
-    return status(f'{name}: stability', LEVELS[found.status], found.message, values,
-                  hardware_id)
-
-
-def _number(text):
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return None
-
-
-def quantity_from(values, label, unit):
+def statuses(found, name, hardware_id, origin_ns):
     """
-    Read back the :class:`~rigid_body_dynamics.physics.analysis.Quantity` that quantity() wrote.
+    Return the three DiagnosticStatus of ``found`` for node ``name``.
 
-    ``values`` is a status' key -> string mapping; None when the label is absent.
+    ``origin_ns``: the trajectory's origin (int ns), which makes the baseline stamp absolute.
     """
-    suffix = f' ({unit})' if unit else ''
-    measured = values.get(f'{label}, measured{suffix}')
-    if measured is None:
-        return None
-    number = _number(measured)
-    why = '' if number is not None else str(measured).replace('not available: ', '', 1)
-    return analysis.Quantity(number, _number(values.get(f'{label}, theory{suffix}')),
-                             values.get(f'{label} status', analysis.OK if number is not None
-                                        else analysis.UNAVAILABLE), unit, why=why)
+    sections = findings_render.key_values(found, origin_ns)
+    return [status(f'{name}: {check}', LEVELS[sections[check][0]], sections[check][1],
+                   sections[check][2], hardware_id) for check in CHECKS]
+
+
+def findings_from(received):
+    """
+    Read an analyzer's statuses back into Findings.
+
+    ``received``: {'conservation' | 'precession' | 'stability': (level byte,
+    message, {key: value text})}, e.g. from one DiagnosticArray.
+    """
+    status_of = {DiagnosticStatus.OK: findings.OK, DiagnosticStatus.WARN: findings.WARN,
+                 DiagnosticStatus.ERROR: findings.ERROR}
+    return findings_render.from_key_values(
+        {check: (status_of.get(level, findings.ERROR), message, values)
+         for check, (level, message, values) in received.items()})

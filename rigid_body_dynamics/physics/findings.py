@@ -1,0 +1,169 @@
+"""
+The findings of the analysis, as data: measured numbers beside theory, and their statuses.
+
+:func:`~.analysis.analyse` makes them, :mod:`.tolerances` decides their statuses,
+:mod:`.findings_render` turns them into text, table rows and diagnostics key/values
+(and reads those back). A status is ``OK``, ``WARN`` (above the tolerance),
+``ERROR`` (above 100 times it) or ``unavailable`` (with the reason, never a
+made-up number). Axis indices are 0-based body axes (the JSON form adds 1).
+"""
+
+from dataclasses import dataclass
+import math
+
+OK, WARN, ERROR, UNAVAILABLE = 'OK', 'WARN', 'ERROR', 'unavailable'
+RANK = {UNAVAILABLE: -1, OK: 0, WARN: 1, ERROR: 2}
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """
+    A measured number beside its prediction, and whether they agree.
+
+    ``measured`` and ``theory`` are floats or None (None: not available,
+    ``why`` says why); ``status`` is OK / WARN / ERROR against ``tolerance``
+    (relative), or ``unavailable``; ``unit`` as in the labels.
+    """
+
+    measured: object
+    theory: object
+    status: str
+    unit: str = ''
+    tolerance: float = math.nan
+    why: str = ''
+
+    @property
+    def relative_error(self):
+        """|measured - theory| / |theory|, or None when either is missing or theory is 0."""
+        if self.measured is None or self.theory is None or not self.theory:
+            return None
+        return abs(self.measured - self.theory) / abs(self.theory)
+
+
+@dataclass(frozen=True)
+class ConservationFindings:
+    """
+    Free motion: largest drift from the baseline; under torque: balance-law residuals.
+
+    ``mode``: 'free motion' or 'balance laws' (torque in the window) or
+    'unavailable'. Free: ``energy_drift`` |T/T0 - 1|, ``momentum_drift``
+    ||L|/|L0| - 1|, ``direction_drift`` angle(L_w, L_w0) rad, the largest over
+    the samples; ``baseline_ns`` the baseline's stamp (ns since origin).
+    Balance: ``energy_residual``, ``momentum_residual`` (estimators.balance) and
+    the ``work`` (J) over the window.
+    """
+
+    status: str
+    message: str
+    mode: str
+    energy_drift: object = None
+    momentum_drift: object = None
+    direction_drift: object = None
+    baseline_ns: object = None
+    energy_residual: object = None
+    momentum_residual: object = None
+    work: object = None
+    energy_tolerance: float = math.nan
+    momentum_tolerance: float = math.nan
+
+
+@dataclass(frozen=True)
+class PrecessionFindings:
+    """
+    Precession of the free motion.
+
+    ``kind``: 'axisymmetric', 'asymmetric', 'spherical', 'principal spin' or
+    'unavailable'. Axisymmetric: ``body_rate`` (omega about the symmetry axis
+    in the body frame, the seed's Omega), ``lab_rate`` (the symmetry axis
+    about L), the cone angles (rad). Asymmetric: ``omega_period`` (s) and
+    ``mean_precession`` of the ``circled_axis`` about L (rad/s), measured over
+    a whole number of periods of omega.
+    """
+
+    status: str
+    message: str
+    kind: str
+    body_rate: Quantity = None
+    lab_rate: Quantity = None
+    omega_period: Quantity = None
+    mean_precession: Quantity = None
+    cones: object = None
+    symmetry_axis: object = None
+    circled_axis: object = None
+    polhode_family: str = ''
+
+
+@dataclass(frozen=True)
+class StabilityFindings:
+    """
+    The spin about the principal axis the motion stays nearest over the window.
+
+    ``axis`` (0-based), ``kind`` ('stable', 'unstable', 'marginal', 'rest'),
+    ``family`` and ``separatrix_distance`` of the polhode; stable:
+    ``wobble_frequency`` (rad/s, 2 pi / period of omega: the same frequency as
+    the precession's body rate for a top); unstable: ``growth_rate`` (1/s)
+    and ``flip_interval`` (s). Status WARN while unstable.
+    """
+
+    status: str
+    message: str
+    axis: object = None
+    kind: str = ''
+    family: str = ''
+    separatrix_distance: float = math.nan
+    wobble_frequency: Quantity = None
+    growth_rate: Quantity = None
+    flip_interval: Quantity = None
+
+
+@dataclass(frozen=True)
+class Findings:
+    """Everything :func:`analyse` says about a trajectory."""
+
+    samples: int
+    span: float
+    conservation: ConservationFindings
+    precession: PrecessionFindings
+    stability: StabilityFindings
+    kinetic_energy: object = None
+    angular_momentum_norm: object = None
+    under_torque: bool = False
+
+    def to_dict(self):
+        """Return the JSON form (``rigid_body_analyze --json``): numbers, None where n/a."""
+        def num(x):
+            return None if x is None or not math.isfinite(x) else float(x)
+
+        def quantity(prefix, qty):
+            if qty is None:
+                return {prefix: None, f'{prefix}_theory': None}
+            return {prefix: num(qty.measured), f'{prefix}_theory': num(qty.theory)}
+        c, p, s = self.conservation, self.precession, self.stability
+        out = {'samples': self.samples, 'span_s': self.span,
+               'kinetic_energy': num(self.kinetic_energy),
+               'angular_momentum_norm': num(self.angular_momentum_norm),
+               'conservation': {'status': c.status, 'mode': c.mode,
+                                'energy_drift': num(c.energy_drift),
+                                'momentum_drift': num(c.momentum_drift),
+                                'direction_drift': num(c.direction_drift),
+                                'energy_residual': num(c.energy_residual),
+                                'momentum_residual': num(c.momentum_residual),
+                                'message': c.message},
+               'precession': {'status': p.status, 'kind': p.kind, 'message': p.message,
+                              **quantity('body_rate', p.body_rate),
+                              **quantity('lab_rate', p.lab_rate if p.lab_rate is not None
+                                         else p.mean_precession),
+                              **quantity('omega_period', p.omega_period)},
+               'stability': {'status': s.status, 'message': s.message,
+                             'axis': None if s.axis is None else int(s.axis) + 1,
+                             'class': s.kind or None, 'family': s.family or None,
+                             'separatrix_distance': num(s.separatrix_distance),
+                             **quantity('growth_rate', s.growth_rate),
+                             **quantity('flip_interval', s.flip_interval),
+                             **quantity('wobble_frequency', s.wobble_frequency)}}
+        return out
+
+    def lines(self):
+        """Return readable lines: each number beside theory (see findings_render)."""
+        from .findings_render import text_lines
+        return text_lines(self)
