@@ -26,14 +26,14 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'rigid_body_demo = rigid_body_dynamics.demo:main',
+            'rigid_body_demo = rigid_body_dynamics.tools.demo:main',
             'attitude_simulator = rigid_body_dynamics.nodes.entry:simulator',
             'attitude_analyzer = rigid_body_dynamics.nodes.entry:analyzer',
             'poinsot_visualizer = rigid_body_dynamics.nodes.entry:poinsot',
             'attitude_fleet = rigid_body_dynamics.nodes.entry:fleet',
             'attitude_controller = rigid_body_dynamics.nodes.entry:controller',
-            'rigid_body_report = rigid_body_dynamics.report:main',
-            'rigid_body_analyze = rigid_body_dynamics.analyze:main',
+            'rigid_body_report = rigid_body_dynamics.tools.report:main',
+            'rigid_body_analyze = rigid_body_dynamics.tools.analyze:main',
         ],
         # fixtures for users' topic-based tests; inert unless a test asks for them
         'pytest11': ['rigid_body_dynamics = rigid_body_dynamics.testing'],

@@ -29,7 +29,7 @@ def make_bag(path, messages=MESSAGES):
     run = simulate(body.moments, body.omega0, body.q0, duration=messages * 1e-3, dt=1e-3)
     t_ns = 1_764_547_200_000_000_000 + np.arange(run.t.size, dtype=np.int64) * 1_000_000
     chunk = 100_000
-    from rigid_body_dynamics import bags
+    from rigid_body_dynamics.messages import bags
     from bag_writers import TOPICS
     with bags.BagWriter(path, TOPICS, 'mcap') as writer:
         for i in range(0, t_ns.size, chunk):
@@ -51,12 +51,12 @@ def _measure(path):
     made = make_bag(path)
     size = sum(os.path.getsize(os.path.join(path, f)) for f in os.listdir(path))
     start = time.perf_counter()
-    out = subprocess.run([sys.executable, '-m', 'rigid_body_dynamics.analyze', path, '--json'],
-                         capture_output=True, text=True, timeout=600)
+    out = subprocess.run([sys.executable, '-m', 'rigid_body_dynamics.tools.analyze', path,
+                          '--json'], capture_output=True, text=True, timeout=600)
     total = time.perf_counter() - start
     if out.returncode != 0:
         raise RuntimeError(out.stderr)
-    from rigid_body_dynamics import bags
+    from rigid_body_dynamics.messages import bags
     from rigid_body_dynamics.physics.analysis import analyse
     start = time.perf_counter()
     traj, info = bags.read_trajectory(path)

@@ -13,7 +13,7 @@ import os
 import re
 
 import numpy as np
-from rigid_body_dynamics import bags
+from rigid_body_dynamics.messages import bags
 
 ODOM_FRAME, BODY_FRAME = 'odom', 'base_link'
 

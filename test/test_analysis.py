@@ -187,7 +187,7 @@ def test_the_analyzers_tolerance_parameters_refuse_zero(name):
 
 
 def test_rigid_body_analyze_refuses_a_zero_tolerance(capsys):
-    from rigid_body_dynamics import analyze
+    from rigid_body_dynamics.tools import analyze
     with pytest.raises(SystemExit) as stop:
         analyze.main(['any.mcap', '--rate-tolerance', '0'])
     assert stop.value.code == 2
@@ -219,7 +219,7 @@ def test_the_analyzers_diagnostics_read_back_into_the_same_findings():
     directly, for every kind of finding. A key renamed on one side only fails here.
     """
     from rigid_body_dynamics.physics.findings_render import table_rows, text_lines
-    from rigid_body_dynamics.ros import diagnostics
+    from rigid_body_dynamics.nodes import analyzer_diagnostics as diagnostics
     from rigid_body_dynamics.ros.conversions import status_values
     seen = set()
     for case, found in _cases().items():
@@ -231,6 +231,11 @@ def test_the_analyzers_diagnostics_read_back_into_the_same_findings():
         back = diagnostics.findings_from(received)
         assert text_lines(back)[1:] == text_lines(found)[1:], case
         assert table_rows(back) == table_rows(found), case
+    # every key written is in the manual's table (made from the same module)
+    import re
+    from rigid_body_dynamics.physics.findings_render import reference_rows
+    listed = [re.escape(key).replace('<axis>', '[1-3]') for _sec, key, _m in reference_rows()]
+    assert [k for k in seen if not any(re.fullmatch(p, k) for p in listed)] == []
     # every quantity of the reader's table was written by some case, with its unit
     for key in ('body rate, measured (rad/s)', 'lab rate, measured (rad/s)',
                 'omega period, measured (s)',

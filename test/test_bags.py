@@ -16,7 +16,7 @@ import sys
 from bag_writers import rosbags_messages, write_mcap_ros2, write_rosbags
 import numpy as np
 import pytest
-from rigid_body_dynamics import bags, cdr
+from rigid_body_dynamics.messages import bags, cdr
 from rigid_body_dynamics.physics import presets, quaternions, simulate
 from rigid_body_dynamics.physics.analysis import analyse, Trajectory
 
@@ -26,8 +26,8 @@ TENSOR_123 = [1.0, 2.0, 3.0, 0.0, 0.0, 0.0]
 
 def analyze(*args, timeout=120):
     """Run rigid_body_analyze as a user does; returns (exit code, stdout, stderr)."""
-    out = subprocess.run([sys.executable, '-m', 'rigid_body_dynamics.analyze', *map(str, args)],
-                         capture_output=True, text=True, timeout=timeout)
+    out = subprocess.run([sys.executable, '-m', 'rigid_body_dynamics.tools.analyze',
+                          *map(str, args)], capture_output=True, text=True, timeout=timeout)
     return out.returncode, out.stdout, out.stderr
 
 
@@ -217,8 +217,9 @@ def test_live_analyzer_and_rigid_body_analyze_agree_on_the_same_stamps(launch, p
     arrays = probe.subscribe(DiagnosticArray, '/diagnostics')
     probe.wait_for('/diagnostics', 1, timeout=30.0)
     bag = tmp_path / 'live'
-    recorder = subprocess.Popen([sys.executable, '-m', 'rigid_body_dynamics.report', '--record',
-                                 str(bag), '--duration', '12', '--out', str(tmp_path / 'r')],
+    recorder = subprocess.Popen([sys.executable, '-m', 'rigid_body_dynamics.tools.report',
+                                 '--record', str(bag), '--duration', '12', '--out',
+                                 str(tmp_path / 'r')],
                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     probe.spin_until(lambda: recorder.poll() is not None, 90.0, 'the recording')
     assert recorder.returncode == 0, recorder.stdout.read()

@@ -7,7 +7,7 @@ import sys
 
 
 def _demo(*args):
-    return subprocess.run([sys.executable, '-m', 'rigid_body_dynamics.demo', *args],
+    return subprocess.run([sys.executable, '-m', 'rigid_body_dynamics.tools.demo', *args],
                           capture_output=True, text=True, timeout=120, env=os.environ.copy())
 
 

@@ -37,9 +37,11 @@ def make_body(**kwargs):
     return BodySimulation(**options)
 
 
-def test_the_physics_and_the_engine_import_no_ros():
+def test_the_physics_the_engine_and_the_messages_import_no_ros():
     code = ('import sys, rigid_body_dynamics.physics, rigid_body_dynamics.engine; '
             'import rigid_body_dynamics.physics.disturbances; '
+            'import rigid_body_dynamics.physics.findings_render; '
+            'import rigid_body_dynamics.messages.bags, rigid_body_dynamics.messages.cdr; '
             'print(sorted(m for m in sys.modules if m == "rclpy" or m.startswith('
             '("rclpy.", "rosidl_runtime_py", "rigid_body_dynamics.ros"))))')
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True, timeout=60)

@@ -128,7 +128,7 @@ def test_rviz2_is_what_the_launch_file_starts():
 def test_a_tool_without_an_optional_module_says_what_to_install(tmp_path, tool, args, hidden):
     # the module is made unimportable in the tool's own process (None in sys.modules)
     code = (f'import sys; sys.modules[{hidden!r}] = None; '
-            f'from rigid_body_dynamics.{tool} import main; sys.exit(main(sys.argv[1:]))')
+            f'from rigid_body_dynamics.tools.{tool} import main; sys.exit(main(sys.argv[1:]))')
     run = subprocess.run([sys.executable, '-c', code, *args, '--out', str(tmp_path)]
                          if tool == 'report' else [sys.executable, '-c', code, *args],
                          capture_output=True, text=True, timeout=60, cwd=tmp_path)

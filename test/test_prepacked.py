@@ -135,7 +135,7 @@ def test_cdr_field_offsets_are_where_rclpy_serialises_the_fields():
     import struct
     from nav_msgs.msg import Odometry
     from rclpy.serialization import serialize_message
-    from rigid_body_dynamics import cdr
+    from rigid_body_dynamics.messages import cdr
 
     def base_after(*frames):
         """Payload offset after the header stamp and the frame id strings, 8-aligned."""

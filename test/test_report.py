@@ -5,9 +5,9 @@ import os
 from bag_writers import rosbags_messages, write_rosbags
 import numpy as np
 import pytest
-from rigid_body_dynamics import report
-from rigid_body_dynamics.bags import read_trajectory
+from rigid_body_dynamics.messages.bags import read_trajectory
 from rigid_body_dynamics.physics import theory
+from rigid_body_dynamics.tools import report
 
 
 def test_offline_report_files_and_plotted_data(tmp_path):
@@ -121,7 +121,7 @@ def test_record_from_the_running_simulator(launch, tmp_path):
 
 def test_interactive_views_draw_this_run_and_the_box_has_its_moments(tmp_path):
     """report_page: the equivalent box reproduces the moments; frames turn it with the run."""
-    from rigid_body_dynamics import report_page
+    from rigid_body_dynamics.tools import report_page
     from rigid_body_dynamics.physics import quaternions
     from rigid_body_dynamics.physics.inertia import equivalent_box
     for moments in ((1.0, 2.0, 3.0), (0.0419, 0.0419, 0.00667), (2.0, 2.5, 3.5)):

@@ -12,7 +12,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from rigid_body_dynamics import report
+from rigid_body_dynamics.tools import report
 
 FLAGS = ['--headless', '--no-sandbox', '--disable-gpu', '--use-angle=swiftshader',
          '--enable-unsafe-swiftshader', '--disable-quic', '--no-first-run',

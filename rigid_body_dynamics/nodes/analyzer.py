@@ -11,7 +11,7 @@ longer than ``max_gap`` s restarts the estimates instead of corrupting them.
 Every ``diagnostic_period`` (steady clock) the samples of the last ``window``
 s (by stamp) go to :func:`rigid_body_dynamics.physics.analysis.analyse`, the
 one analysis every door shares, and its findings are formatted by
-:mod:`.diagnostics`. Odometry is read by :mod:`rigid_body_dynamics.samples`
+:mod:`.analyzer_diagnostics`. Odometry is read by :mod:`rigid_body_dynamics.messages.samples`
 (twist frames honoured; stamps as integer ns). Free-motion drift is measured
 from the first sample by stamp of the current torque-free segment, kept here
 because the window may have dropped it. Until there is enough data a
@@ -33,10 +33,11 @@ from rclpy.serialization import deserialize_message
 from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
-from .. import samples
+from . import analyzer_diagnostics as diagnostics
+from ..messages import samples
 from ..physics import Inertia
 from ..physics.analysis import analyse, Tolerances, Trajectory
-from ..ros import conversions as conv, diagnostics
+from ..ros import conversions as conv
 from ..ros.intake import Intake
 from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
 from ..ros.runner import run

@@ -3,9 +3,10 @@ The findings in words and as key/values: one rendering for every door, and its r
 
 :func:`text_lines` (``rigid_body_analyze``, the demo, ``Findings.lines()``) and
 :func:`table_rows` (the report) write the same labels; :func:`key_values` writes
-the analyzer's diagnostics values (no ROS here: :mod:`rigid_body_dynamics.ros.diagnostics`
-wraps them in DiagnosticStatus), and :func:`from_key_values` reads them back into
-:class:`~.findings.Findings`, from the same tables, so a renamed key changes both
+the analyzer's diagnostics values (no ROS here:
+:mod:`rigid_body_dynamics.nodes.analyzer_diagnostics` wraps them in DiagnosticStatus),
+and :func:`from_key_values` reads them back into :class:`~.findings.Findings`, from
+the same tables, so a renamed key changes both
 sides (the demo prints what the analyzer found with :func:`text_lines`). The keys
 are an interface users parse, listed in the manual's attitude_analyzer page.
 
@@ -46,6 +47,61 @@ CONSERVATION = (
 )
 _MODES = {'free motion': 'free motion',
           'balance laws': 'balance laws (torque applied in the window)'}
+#: The other keys, for the manual (generated from here; the suite checks that every key
+#: the analyzer writes is listed): (status, key, meaning).
+OTHER_KEYS = (
+    ('conservation', 'mode', '`free motion` or `balance laws (torque applied in the window)`'),
+    ('conservation', 'baseline stamp (s)', 'stamp of the drift baseline (free motion)'),
+    ('conservation', 'energy tolerance', 'the tolerance the energy was checked against'),
+    ('conservation', 'momentum tolerance', 'the tolerance the momentum was checked against'),
+    ('precession', 'polhode family', 'which axis the polhode circles, or separatrix'),
+    ('precession', 'circled axis', 'the principal axis (1-3) the polhode circles'),
+    ('precession', 'body cone half-angle (rad)', 'axisymmetric: omega about the symmetry axis'),
+    ('precession', 'lab cone half-angle (rad)', 'axisymmetric: omega about L'),
+    ('precession', 'nutation angle (rad)', 'axisymmetric: symmetry axis to L'),
+    ('stability', 'nearest principal axis', 'the axis (1-3) the motion stays nearest'),
+    ('stability', 'class', '`stable`, `unstable`, `marginal` or `rest`'),
+    ('stability', 'polhode family', 'as in precession'),
+    ('stability', 'separatrix distance (S/G^2)', 'distance of the polhode from the separatrix'),
+    ('stability', 'wobble frequency (rad/s)', 'the wobble frequency\'s theory (older key)'),
+)
+#: What each quantity is, for the manual.
+MEANINGS = {
+    'body_rate': 'axisymmetric: omega turning about the symmetry axis in the body (the seed\'s '
+                 'Omega)',
+    'lab_rate': 'axisymmetric: the symmetry axis turning about L, |L|/I_perp',
+    'omega_period': 'asymmetric: the period of omega(t)',
+    'mean_precession': 'asymmetric: the circled axis\'s mean precession about L',
+    'growth_rate': 'unstable spin: growth rate of a small departure',
+    'flip_interval': 'unstable spin: time between flips',
+    'wobble_frequency': 'stable spin: 2 pi / period of omega',
+}
+
+
+def reference_rows():
+    """
+    Return the analyzer's diagnostics keys for the manual: (status, key, meaning) rows.
+
+    ``<axis>`` stands for the circled axis (1-3).
+    """
+    rows = [(sec, key, meaning) for sec, key, meaning in OTHER_KEYS
+            if sec == 'conservation' and key in ('mode', 'baseline stamp (s)')]
+    rows += [('conservation', key, f'{mode}: {field.replace("_", " ")}')
+             for mode, field, key in CONSERVATION]
+    rows += [(sec, key, meaning) for sec, key, meaning in OTHER_KEYS
+             if sec == 'conservation' and key not in ('mode', 'baseline stamp (s)')]
+    for section in ('precession', 'stability'):
+        rows += [(sec, key, meaning) for sec, key, meaning in OTHER_KEYS if sec == section]
+        for sec, field, key, _text in QUANTITIES:
+            if sec != section:
+                continue
+            key, unit = key.format(axis='<axis>'), UNITS[field]
+            rows += [(sec, f'{key}, measured ({unit})', MEANINGS[field] +
+                      ', measured (or `not available: <why>`)'),
+                     (sec, f'{key}, theory ({unit})', 'its prediction'),
+                     (sec, f'{key} error (rel.)', '|measured - theory| / |theory|'),
+                     (sec, f'{key} status', '`OK`, `WARN`, `ERROR` against the tolerance')]
+    return rows
 
 
 def _labels(section, field, found_section):

@@ -4,7 +4,7 @@ torque_cmd messages -> the engine's command values, and the frame rule of a torq
 The simulator's integration thread takes the serialised messages pending on
 ``torque_cmd`` (:class:`~.intake.Intake`) and :class:`TorqueDecoder` turns them
 into one :class:`~rigid_body_dynamics.engine.commands.TorqueCommands`: read in one
-go with :mod:`rigid_body_dynamics.cdr` when they share a frame id (a flood costs
+go with :mod:`rigid_body_dynamics.messages.cdr` when they share a frame id (a flood costs
 little), else deserialised one by one. Everything after that (checks, counts,
 the held command, its timing) is the engine's.
 """
@@ -15,8 +15,8 @@ from geometry_msgs.msg import WrenchStamped
 from rclpy.serialization import deserialize_message
 
 from . import conversions as conv
-from .. import cdr
 from ..engine.commands import TorqueCommands
+from ..messages import cdr
 
 
 def steady_times(received_system_ns):

@@ -9,7 +9,7 @@ messages but :meth:`Intake.take`, which drains everything pending in one go.
 The owner calls it from a timer (the analyzer: every 100 ms), or blocks in
 :meth:`Intake.wait` until a message is pending (the simulator's lockstep
 thread: no executor hop between the controller's answer and the next step).
-Messages are taken serialised (``raw``), for :mod:`rigid_body_dynamics.cdr`
+Messages are taken serialised (``raw``), for :mod:`rigid_body_dynamics.messages.cdr`
 to read in a batch or ``deserialize_message`` one by one. rclpy has no public
 take() or wait set; these are the calls its executor makes
 (``handle.take_message`` inside ``with handle``, ``_rclpy.WaitSet``), in

@@ -16,9 +16,9 @@ import argparse
 import json
 import sys
 
-from . import optional
-from .bags import BagError, read_trajectory
-from .physics.analysis import analyse, Tolerances
+from .. import optional
+from ..messages.bags import BagError, read_trajectory
+from ..physics.analysis import analyse, Tolerances
 
 
 def main(argv=None):

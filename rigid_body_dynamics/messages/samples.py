@@ -3,7 +3,7 @@ Odometry and torque messages -> attitude samples in the body frame, for every re
 
 The live analyzer (rclpy) and the bag reader (rosbags) both take serialised
 messages and go through these functions: the fields of a batch are read
-straight into numpy by :mod:`rigid_body_dynamics.cdr`; a batch whose layout
+straight into numpy by :mod:`rigid_body_dynamics.messages.cdr`; a batch whose layout
 differs (frame ids of different lengths) is decoded message by message with
 the caller's ``decode(raw)`` (rclpy's or rosbags' deserialiser: both messages
 have the same field names), and the same frame rules apply. No ROS import.
@@ -19,7 +19,7 @@ is not the frame the inertia belongs to: those samples are dropped and counted.
 import numpy as np
 
 from . import cdr
-from .physics import quaternions
+from ..physics import quaternions
 
 
 def stamp_ns(stamp):

@@ -4,7 +4,7 @@ rosbag2 bags (sqlite3 or MCAP folders) and bare .mcap / .db3 files <-> Trajector
 Reading and writing go through the ``rosbags`` library (pure Python, no ROS
 install needed): the bags are what ``ros2 bag record`` writes on Jazzy
 (metadata version 9, MCAP by default) and what ``ros2 bag play``, Foxglove and
-PlotJuggler open. Messages become samples through :mod:`rigid_body_dynamics.samples`,
+PlotJuggler open. Messages become samples through :mod:`rigid_body_dynamics.messages.samples`,
 exactly as the live analyzer takes them (frames honoured, stamps in integer
 ns). Every failure is a :class:`BagError` whose text is one line.
 """
@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from . import samples
-from .physics.analysis import Trajectory
-from .physics.inertia import Inertia
+from ..physics.analysis import Trajectory
+from ..physics.inertia import Inertia
 
 ODOMETRY = 'nav_msgs/msg/Odometry'
 WRENCH = 'geometry_msgs/msg/WrenchStamped'

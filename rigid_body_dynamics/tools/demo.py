@@ -21,10 +21,10 @@ import time
 
 import numpy as np
 
-from .physics import FreeRigidBody, INTEGRATORS, presets, quaternions, simulate
-from .physics.analysis import analyse, Trajectory
-from .physics.control import QuaternionPD, settling_time
-from .physics.findings_render import text_lines
+from ..physics import FreeRigidBody, INTEGRATORS, presets, quaternions, simulate
+from ..physics.analysis import analyse, Trajectory
+from ..physics.control import QuaternionPD, settling_time
+from ..physics.findings_render import text_lines
 
 #: The closed-loop scene: 30 degrees about x from rest, wn 2 rad/s, zeta 0.7, 100 Hz, 10 s.
 SLEW = {'target': (math.sin(math.radians(15.0)), 0.0, 0.0, math.cos(math.radians(15.0))),
@@ -60,7 +60,7 @@ def findings(statuses):
     The values are read back into the analysis' Findings (by the module that wrote
     them) and printed with the same renderer as the offline analysis.
     """
-    from .ros import diagnostics
+    from ..nodes import analyzer_diagnostics as diagnostics
     return text_lines(diagnostics.findings_from(statuses))[1:]
 
 
@@ -74,8 +74,8 @@ def run_nodes(preset, integrator, rate):
     """
     from diagnostic_msgs.msg import DiagnosticArray
 
-    from .ros.client import interrupt, RosClient, start_node, WaitTimeout
-    from .ros.conversions import status_values
+    from ..ros.client import interrupt, RosClient, start_node, WaitTimeout
+    from ..ros.conversions import status_values
     body = presets.get(preset)
     kind = FreeRigidBody(body.moments, body.omega0).shape.kind
     check, key = _READY.get(kind, ('conservation', 'mode'))
@@ -164,8 +164,8 @@ def run_closed_loop():
     from nav_msgs.msg import Odometry
     from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-    from .ros.client import interrupt, RosClient, start_node
-    from .ros.conversions import time_ns
+    from ..ros.client import interrupt, RosClient, start_node
+    from ..ros.conversions import time_ns
     body = presets.get(presets.DEFAULT)
     quiet = ['--log-level', 'warn']
     sim = start_node('simulator', quiet + [

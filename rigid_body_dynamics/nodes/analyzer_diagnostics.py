@@ -12,8 +12,8 @@ and :func:`findings_from` reads them back with
 
 from diagnostic_msgs.msg import DiagnosticStatus
 
-from .conversions import status
 from ..physics import findings, findings_render
+from ..ros.conversions import status
 
 LEVELS = {findings.OK: DiagnosticStatus.OK, findings.WARN: DiagnosticStatus.WARN,
           findings.ERROR: DiagnosticStatus.ERROR, findings.UNAVAILABLE: DiagnosticStatus.OK}

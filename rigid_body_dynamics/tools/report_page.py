@@ -15,8 +15,8 @@ import os
 
 import numpy as np
 
-from .physics import estimators, momentum_sphere, poinsot, quaternions
-from .physics.inertia import equivalent_box
+from ..physics import estimators, momentum_sphere, poinsot, quaternions
+from ..physics.inertia import equivalent_box
 
 #: Frames of the animation (evenly spaced samples of the run).
 FRAMES = 150
