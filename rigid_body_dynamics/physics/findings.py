@@ -34,7 +34,7 @@ class Quantity:
 
     @property
     def relative_error(self):
-        """|measured - theory| / |theory|, or None when either is missing or theory is 0."""
+        """Return ``abs(measured - theory) / abs(theory)``, or None (either missing, theory 0)."""
         if self.measured is None or self.theory is None or not self.theory:
             return None
         return abs(self.measured - self.theory) / abs(self.theory)
@@ -46,8 +46,8 @@ class ConservationFindings:
     Free motion: largest drift from the baseline; under torque: balance-law residuals.
 
     ``mode``: 'free motion' or 'balance laws' (torque in the window) or
-    'unavailable'. Free: ``energy_drift`` |T/T0 - 1|, ``momentum_drift``
-    ||L|/|L0| - 1|, ``direction_drift`` angle(L_w, L_w0) rad, the largest over
+    'unavailable'. Free: ``energy_drift`` ``abs(T/T0 - 1)``, ``momentum_drift``
+    ``abs(norm(L)/norm(L0) - 1)``, ``direction_drift`` angle(L_w, L_w0) rad, the largest over
     the samples; ``baseline_ns`` the baseline's stamp (ns since origin).
     Balance: ``energy_residual``, ``momentum_residual`` (estimators.balance) and
     the ``work`` (J) over the window.

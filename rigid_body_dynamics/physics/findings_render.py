@@ -63,15 +63,15 @@ OTHER_KEYS = (
     ('stability', 'class', '`stable`, `unstable`, `marginal` or `rest`'),
     ('stability', 'polhode family', 'as in precession'),
     ('stability', 'separatrix distance (S/G^2)', 'distance of the polhode from the separatrix'),
-    ('stability', 'wobble frequency (rad/s)', 'the wobble frequency\'s theory (older key)'),
+    ('stability', 'wobble frequency (rad/s)', "the wobble frequency's theory (older key)"),
 )
 #: What each quantity is, for the manual.
 MEANINGS = {
-    'body_rate': 'axisymmetric: omega turning about the symmetry axis in the body (the seed\'s '
+    'body_rate': "axisymmetric: omega turning about the symmetry axis in the body (the seed's "
                  'Omega)',
     'lab_rate': 'axisymmetric: the symmetry axis turning about L, |L|/I_perp',
     'omega_period': 'asymmetric: the period of omega(t)',
-    'mean_precession': 'asymmetric: the circled axis\'s mean precession about L',
+    'mean_precession': "asymmetric: the circled axis's mean precession about L",
     'growth_rate': 'unstable spin: growth rate of a small departure',
     'flip_interval': 'unstable spin: time between flips',
     'wobble_frequency': 'stable spin: 2 pi / period of omega',
