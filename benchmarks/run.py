@@ -49,7 +49,8 @@ def main():
     parser.add_argument('--only', choices=['nodes', 'torque', 'soak', 'soak-rt', 'flood',
                                            'bodies', 'hosts', 'analyzer-memory', 'bag',
                                            'lockstep', 'bodies-asymmetric', 'latency',
-                                           'publish', 'flow-batch', 'command-path'],
+                                           'publish', 'flow-batch', 'command-path',
+                                           'simulate-cost'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -110,6 +111,7 @@ SCALE = {
     'publish': ('publish', 'Publishing serialised state'),
     'flow-batch': ('flow_batch', 'The exact flow one time at a time and over arrays'),
     'command-path': ('command_path', 'The command path in the engine, before and after'),
+    'simulate-cost': ('simulate_cost', 'simulate() with a callable torque across the separatrix'),
 }
 
 

@@ -49,3 +49,27 @@ def test_bad_arguments_are_refused():
         simulate((1.0, 1.0, 5.0), (0.0, 0.0, 1.0))
     with pytest.raises(ValueError, match='unknown integrator'):
         simulate((1.0, 2.0, 3.0), (0.0, 0.0, 1.0), integrator='leapfrog')
+
+
+def test_the_per_step_frame_changes_match_the_inertias_array_methods():
+    """UserFrame (plain Python, simulate()'s hot path) against Inertia's numpy methods."""
+    from rigid_body_dynamics.physics.simulation import UserFrame
+    rng = np.random.default_rng(11)
+    rot = Rotation.from_rotvec([0.3, -0.5, 0.4])
+    tensor = Inertia.from_tensor(rot.as_matrix() @ np.diag([1.0, 2.0, 3.0]) @ rot.as_matrix().T)
+    for inertia in (tensor, Inertia((1.0, 2.0, 3.0))):
+        frame = UserFrame(inertia)
+        for _ in range(50):
+            v = rng.normal(size=3)
+            q = rng.normal(size=4)
+            q /= np.linalg.norm(q)
+            np.testing.assert_allclose(frame.to_body(v), inertia.to_body(v), rtol=0, atol=1e-15)
+            np.testing.assert_allclose(frame.to_principal(v), inertia.to_principal(v), rtol=0,
+                                       atol=1e-15)
+            np.testing.assert_allclose(frame.attitude_to_body(q), inertia.attitude_to_body(q),
+                                       rtol=0, atol=1e-15)
+            np.testing.assert_allclose(frame.torque_principal(np.array(v), 0.0),
+                                       inertia.to_principal(v), rtol=0, atol=1e-15)
+        for bad in ((1.0, 2.0), np.zeros(4), 'abc', (1.0, None, 2.0)):
+            with pytest.raises(ValueError, match='must return three numbers'):
+                frame.torque_principal(bad, 1.5)

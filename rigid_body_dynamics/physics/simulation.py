@@ -107,6 +107,7 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     stepper = make_integrator(integrator, inertia.moments, dt,
                               inertia.attitude_to_principal(q0 / np.linalg.norm(q0)),
                               inertia.to_principal(np.asarray(omega0, dtype=float)))
+    frame = UserFrame(inertia)
     if callable(torque):
         user_torque = torque
     else:
@@ -118,8 +119,8 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     for k in range(n + 1):
         if callable(torque) and (k < n or k == 0) and k % torque_every == 0:
             # (the last row repeats the last torque: no step starts there)
-            tb = user_torque(stepper.time, *_user_state(inertia, stepper))
-            tp = _principal(inertia, tb, stepper.time)
+            tb = user_torque(stepper.time, *frame.state(stepper))
+            tp = frame.torque_principal(tb, stepper.time)
         elif not callable(torque):
             tb, tp = body_const, principal_const
         if k % every == 0:
@@ -131,7 +132,7 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
             imp.append(stepper.impulse)
         if imu_every and k % imu_every == 0:
             for column, value in zip(imu, (stepper.time, *gyro.read(
-                    *_user_state(inertia, stepper)))):
+                    *frame.state(stepper)))):
                 column.append(value)
         if k < n:
             try:
@@ -162,19 +163,55 @@ def _imu_every(gyro, dt):
     return every
 
 
-def _principal(inertia, torque_body, t):
-    """Return a user's body torque (N m) as a principal-frame tuple; ValueError if not 3."""
-    try:
-        values = tuple(float(c) for c in np.asarray(torque_body, dtype=float).reshape(3))
-    except (TypeError, ValueError):
-        raise ValueError(f'torque(t={t!r}) must return three numbers (N m), '
-                         f'got {torque_body!r}') from None
-    if inertia.is_principal_frame:
-        return values
-    return tuple(float(c) for c in inertia.to_principal(np.array(values)))
+class UserFrame:
+    """
+    The user's body frame against the principal frame, for one state at a time.
 
+    What :func:`simulate` does at every step of a callable torque: the state into
+    the user's frame (``state``) and the torque out of it (``torque_principal``).
+    Plain Python on tuples: numpy's per-call cost (quaternions.multiply, ``@`` on
+    3-vectors) made a body given by a full tensor cost 2.1 times one given by its
+    principal moments (benchmarks/RESULTS.md, "simulate() with a callable torque").
+    Tested against :class:`~.inertia.Inertia`'s array methods.
+    """
 
-def _user_state(inertia, stepper):
-    """(q, omega) of a stepper in the user's body frame, as arrays."""
-    return (inertia.attitude_to_body(np.array(stepper.q)),
-            inertia.to_body(np.array(stepper.omega)))
+    def __init__(self, inertia):
+        self.identity = inertia.is_principal_frame
+        self.r = tuple(tuple(row) for row in inertia.rotation.tolist())
+        x, y, z, w = (float(c) for c in inertia.quaternion)
+        self.q_conj = (-x, -y, -z, w)
+
+    def to_body(self, v):
+        """Principal-frame components (3,) -> body-frame components, a tuple."""
+        if self.identity:
+            return tuple(v)
+        (a, b, c), (d, e, f), (g, h, i) = self.r
+        x, y, z = v
+        return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+
+    def to_principal(self, v):
+        """Body-frame components (3,) -> principal-frame components, a tuple."""
+        if self.identity:
+            return tuple(v)
+        (a, b, c), (d, e, f), (g, h, i) = self.r
+        x, y, z = v
+        return (a * x + d * y + g * z, b * x + e * y + h * z, c * x + f * y + i * z)
+
+    def attitude_to_body(self, q):
+        """Attitude of the principal frame (x, y, z, w) -> of the body frame, a tuple."""
+        return tuple(q) if self.identity else quaternions.mul_components(q, self.q_conj)
+
+    def state(self, stepper):
+        """(q (4,), omega (3,)) of a stepper in the user's body frame, as arrays."""
+        return (np.array(self.attitude_to_body(stepper.q)), np.array(self.to_body(stepper.omega)))
+
+    def torque_principal(self, torque_body, t):
+        """A user's body torque (3 numbers, N m) as a principal-frame tuple; ValueError if not."""
+        try:
+            x, y, z = np.asarray(torque_body, dtype=float).reshape(3).tolist() \
+                if not isinstance(torque_body, tuple) else torque_body
+            values = (float(x), float(y), float(z))
+        except (TypeError, ValueError):
+            raise ValueError(f'torque(t={t!r}) must return three numbers (N m), '
+                             f'got {torque_body!r}') from None
+        return self.to_principal(values)
