@@ -52,7 +52,7 @@ def test_bad_arguments_are_refused():
 
 
 def test_the_per_step_frame_changes_match_the_inertias_array_methods():
-    """UserFrame (plain Python, simulate()'s hot path) against Inertia's numpy methods."""
+    """Check UserFrame (plain Python, simulate()'s hot path) against Inertia's numpy methods."""
     from rigid_body_dynamics.physics.simulation import UserFrame
     rng = np.random.default_rng(11)
     rot = Rotation.from_rotvec([0.3, -0.5, 0.4])

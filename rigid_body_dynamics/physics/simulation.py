@@ -206,7 +206,7 @@ class UserFrame:
         return (np.array(self.attitude_to_body(stepper.q)), np.array(self.to_body(stepper.omega)))
 
     def torque_principal(self, torque_body, t):
-        """A user's body torque (3 numbers, N m) as a principal-frame tuple; ValueError if not."""
+        """Return a user's body torque (3 numbers, N m) as a principal-frame tuple (ValueError)."""
         try:
             x, y, z = np.asarray(torque_body, dtype=float).reshape(3).tolist() \
                 if not isinstance(torque_body, tuple) else torque_body

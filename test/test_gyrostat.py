@@ -1,0 +1,184 @@
+"""
+The gyrostat (physics/gyrostat.py): a body with reaction wheels, against independent references.
+
+The reference is scipy's DOP853 at rtol 1e-13 on the model written again with numpy
+(np.linalg.solve of the coupled equations), not our scalar code; closed forms for the
+axisymmetric precession and the viscous spin-down; the linear stability theory for a
+spin with rotor momentum. Tolerances are stated at each assertion.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from rigid_body_dynamics.physics.gyrostat import (FRICTION_SMOOTHING, GyrostatIntegrator,
+                                                  precession_rate, spin_stability, Wheels)
+from rigid_body_dynamics.physics.quaternions import rotate_components
+from scipy.integrate import solve_ivp
+
+PYRAMID = tuple(tuple(c / math.sqrt(3.0) for c in g) for g in
+                ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1)))
+
+
+def reference(moments, wheels, y0, duration, applied=None, torque=(0.0, 0.0, 0.0),
+              torque_world=(0.0, 0.0, 0.0)):
+    """DOP853 (rtol 1e-13) of the model in matrix form: y = [omega, q, speeds, angles]."""
+    inertia = np.diag(moments)
+    g = np.array(wheels.axes).reshape(-1, 3)
+    j = np.array(wheels.inertia)
+    a = inertia - (g.T * j) @ g
+    coulomb, viscous = np.array(wheels.coulomb), np.array(wheels.viscous)
+    u = np.zeros(len(j)) if applied is None else np.array(applied)
+    n = len(j)
+
+    def rhs(_t, y):
+        w, q, s = y[:3], y[3:7], y[7:7 + n]
+        h = inertia @ w + g.T @ (j * s)
+        tau = np.array(torque) + np.array(rotate_components((-q[0], -q[1], -q[2], q[3]),
+                                                            torque_world))
+        net = u - (coulomb * np.tanh(s / FRICTION_SMOOTHING) + viscous * s)
+        w_dot = np.linalg.solve(a, tau - np.cross(w, h) - g.T @ net)
+        x, yq, z, qw = q
+        q_dot = 0.5 * np.array([qw * w[0] + yq * w[2] - z * w[1], qw * w[1] + z * w[0] - x * w[2],
+                                qw * w[2] + x * w[1] - yq * w[0],
+                                -(x * w[0] + yq * w[1] + z * w[2])])
+        return np.concatenate([w_dot, q_dot, net / j - g @ w_dot, s])
+    sol = solve_ivp(rhs, (0.0, duration), y0, method='DOP853', rtol=1e-13, atol=1e-15)
+    assert sol.success
+    return sol.y[:, -1]
+
+
+@pytest.mark.parametrize('method,dt,tol', [('exact', 1e-3, 1e-12), ('exact', 1e-2, 1e-12),
+                                           ('rk4', 1e-3, 1e-8)])
+def test_motor_torques_friction_and_external_torque_against_dop853(method, dt, tol):
+    """Four pyramid wheels, motor torques, friction, body and world torque: 3 s."""
+    moments = (1.0, 2.0, 3.0)
+    wheels = Wheels(PYRAMID, (0.02,) * 4, coulomb=(2e-4,) * 4, viscous=(1e-5,) * 4)
+    omega0, speeds0 = (0.3, 1.5, -0.4), (40.0, -25.0, 10.0, 0.5)
+    u = (0.01, -0.02, 0.005, 0.0)
+    stepper = GyrostatIntegrator(moments, wheels, dt, omega0=omega0, speeds0=speeds0,
+                                 method=method)
+    stepper.command_motors(u)
+    for _ in range(int(round(3.0 / dt))):
+        stepper.step((0.02, 0.0, -0.01), (0.0, 0.03, 0.0))
+    y = reference(moments, wheels, np.concatenate([omega0, (0, 0, 0, 1), speeds0, np.zeros(4)]),
+                  3.0, u, (0.02, 0.0, -0.01), (0.0, 0.03, 0.0))
+    scale = max(np.abs(y[:3]).max(), 1.0)
+    assert np.abs(np.array(stepper.omega) - y[:3]).max() / scale < tol
+    assert np.abs(np.array(stepper.q) - y[3:7] / np.linalg.norm(y[3:7])).max() < tol
+    assert np.abs(np.array(stepper.speeds) - y[7:11]).max() / np.abs(speeds0).max() < tol
+    assert np.abs(np.array(stepper.angles) - y[11:]).max() / 100.0 < tol
+
+
+def test_the_balances_hold_to_round_off_torque_free_and_under_torque():
+    """T - T0 = W_ext + W_motor - W_friction and H_w - H_w0 = impulse, 1e-13 relative."""
+    moments = (1.0, 2.0, 3.0)
+    wheels = Wheels(PYRAMID, (0.02,) * 4, coulomb=(2e-4,) * 4, viscous=(1e-5,) * 4)
+    for torque, u in (((0.0, 0.0, 0.0), (0.0,) * 4),
+                      ((0.05, -0.02, 0.01), (0.01, -0.02, 0.0, 0.03))):
+        stepper = GyrostatIntegrator(moments, wheels, 1e-2, omega0=(0.3, 1.5, -0.4),
+                                     speeds0=(40.0, -25.0, 10.0, 0.5))
+        stepper.command_motors(u)
+        t0, h0 = stepper.kinetic_energy, np.array(stepper.angular_momentum_world)
+        for _ in range(1000):
+            stepper.step(torque)
+        energy = stepper.kinetic_energy - t0 - (stepper.work + stepper.motor_work
+                                                - stepper.friction_loss)
+        momentum = np.array(stepper.angular_momentum_world) - h0 - np.array(stepper.impulse)
+        assert abs(energy) / t0 < 1e-13 and np.abs(momentum).max() / np.linalg.norm(h0) < 1e-13
+        assert stepper.friction_loss > 0.0          # friction did dissipate
+
+
+def test_axisymmetric_gyrostat_precesses_at_the_closed_form_rate():
+    """I1 = I2, rotor on axis 3: omega_3 constant, omega_perp turns at lambda (1e-12)."""
+    moments, j, speed = (1.0, 1.0, 1.5), 0.1, 20.0
+    wheels = Wheels(((0.0, 0.0, 1.0),), (j,))
+    omega0 = (0.3, 0.0, 2.0)
+    lam = precession_rate(moments, omega0[2], j * speed)
+    assert lam == pytest.approx(((1.5 - 1.0) * 2.0 + 2.0) / 1.0)
+    stepper = GyrostatIntegrator(moments, wheels, 1e-2, omega0=omega0, speeds0=(speed,))
+    for _ in range(1000):
+        stepper.step()
+    t = stepper.time
+    expected = (0.3 * math.cos(lam * t), 0.3 * math.sin(lam * t), 2.0)
+    assert np.abs(np.array(stepper.omega) - expected).max() < 1e-12
+    assert stepper.speeds[0] == pytest.approx(speed, abs=1e-12)
+
+
+@pytest.mark.parametrize('h_over_omega,stable', [(2.0, True), (0.5, False)])
+def test_a_rotor_stabilises_the_intermediate_axis_only_when_strong_enough(h_over_omega, stable):
+    """Spin 1 rad/s about axis 2 of (1, 2, 3) with rotor momentum h along it: h^2 > omega^2."""
+    moments, omega, j = (1.0, 2.0, 3.0), 1.0, 0.05
+    h = h_over_omega * omega
+    theory_stable, growth = spin_stability(moments, 1, omega, h)
+    assert theory_stable is stable
+    wheels = Wheels(((0.0, 1.0, 0.0),), (j,))
+    eps = 1e-7
+    stepper = GyrostatIntegrator(moments, wheels, 1e-2, omega0=(eps, omega, 0.0),
+                                 speeds0=(h / j,))
+    times, departures = [], []
+    for _ in range(3000):
+        stepper.step()
+        times.append(stepper.time)
+        departures.append(math.hypot(stepper.omega[0], stepper.omega[2]))
+    departures = np.array(departures)
+    if stable:
+        assert departures.max() < 10 * eps          # it stays where it was
+    else:
+        assert growth == pytest.approx(math.sqrt(1.5 * 0.5 / 3.0))
+        # the growth while the departure is small (1e-6 .. 1e-3): a straight line in log
+        window = (departures > 1e-6) & (departures < 1e-3)
+        slope = np.polyfit(np.array(times)[window], np.log(departures[window]), 1)[0]
+        assert slope == pytest.approx(growth, rel=1e-2)
+
+
+def test_motor_limits_clip_and_cut_off_as_basilisk_orders_them():
+    wheels = Wheels(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0)), (0.01, 0.01), max_torque=(0.05, 0.0),
+                    max_speed=(0.0, 100.0))
+    applied, clipped, cut = wheels.limit((0.2, 0.3), (10.0, 100.0))
+    assert applied == (0.05, 0.0) and clipped == (True, False) and cut == (False, True)
+    assert wheels.limit((-0.2, -0.3), (10.0, 100.0))[0] == (-0.05, -0.3)   # braking is allowed
+    # a wheel driven past its limit: stops being driven at the step it reaches it
+    stepper = GyrostatIntegrator((1.0, 2.0, 3.0), wheels, 1e-3, speeds0=(0.0, 99.0))
+    stepper.command_motors((0.0, 0.01))
+    for _ in range(2000):
+        stepper.step()
+    assert 100.0 <= stepper.speeds[1] < 100.0 + 0.01 / 0.01 * 1e-3 * 2.0 and stepper.cut[1] > 0
+
+
+def test_friction_spins_a_wheel_down_as_its_closed_form():
+    """One wheel on axis 3, body at rest: Omega' = -f I3 / (J (I3 - J)), all about axis 3."""
+    moments, j = (1.0, 2.0, 3.0), 0.1
+    rate = moments[2] / (j * (moments[2] - j))
+    viscous = Wheels(((0.0, 0.0, 1.0),), (j,), viscous=(1e-3,))
+    stepper = GyrostatIntegrator(moments, viscous, 1e-2, speeds0=(100.0,))
+    for _ in range(1000):
+        stepper.step()
+    assert stepper.speeds[0] == pytest.approx(100.0 * math.exp(-1e-3 * rate * 10.0), rel=1e-12)
+    # the body takes up the momentum the wheel loses: H stays j * 100 about axis 3
+    assert stepper.angular_momentum_body[2] == pytest.approx(j * 100.0, rel=1e-13)
+    coulomb = Wheels(((0.0, 0.0, 1.0),), (j,), coulomb=(2e-3,))
+    stepper = GyrostatIntegrator(moments, coulomb, 1e-2, speeds0=(100.0,))
+    for _ in range(1000):                            # far from rest: tanh = 1 to 1e-16
+        stepper.step()
+    assert stepper.speeds[0] == pytest.approx(100.0 - 2e-3 * rate * 10.0, rel=1e-13)
+
+
+@pytest.mark.parametrize('kwargs,match', [
+    ({'axes': (1.0, 0.0), 'inertia': ()}, '3 numbers per wheel'),
+    ({'axes': ((0.0, 0.0, 0.0),), 'inertia': (0.1,)}, 'non-zero'),
+    ({'axes': ((1.0, 1.0, 0.0),), 'inertia': (0.1,)}, 'unit vector'),
+    ({'axes': ((1.0, 0.0, 0.0),), 'inertia': (0.1, 0.2)}, 'needs 1 values'),
+    ({'axes': ((1.0, 0.0, 0.0),), 'inertia': (0.0,)}, 'wheel_inertia.0. must be .* > 0'),
+    ({'axes': ((1.0, 0.0, 0.0),), 'inertia': (0.1,), 'max_speed': (-1.0,)},
+     r'wheel_max_speed\[0\] must be a finite number >= 0'),
+    ({'axes': ((1.0, 0.0, 0.0),) * 7, 'inertia': (0.1,) * 7}, 'at most 6'),
+])
+def test_bad_wheels_are_refused_with_the_reason(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        Wheels(**kwargs)
+
+
+def test_wheels_too_heavy_for_the_body_are_refused():
+    with pytest.raises(ValueError, match='too heavy'):
+        GyrostatIntegrator((1.0, 2.0, 3.0), Wheels(((1.0, 0.0, 0.0),), (1.0,)), 1e-3)
