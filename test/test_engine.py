@@ -551,3 +551,94 @@ def test_a_batch_of_commands_counts_and_holds_as_one_by_one():
         for v, f in zip(vectors[start:stop], forces[start:stop]):
             ref.command(v, False, 100 + stop, force=tuple(f))
         assert sliced.counts == ref.counts and sliced.command_held == ref.command_held
+
+
+# --- Reaction wheels through the one command path ---------------------------------------------
+
+def _wheels():
+    from rigid_body_dynamics.physics.gyrostat import Wheels
+    pyramid = [c / math.sqrt(3.0) for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
+               for c in g]
+    return Wheels(pyramid, (0.02,) * 4, max_torque=(0.05,) * 4, max_speed=(200.0,) * 4,
+                  coulomb=(1e-4,) * 4, viscous=(1e-6,) * 4)
+
+
+def test_wheel_commands_act_from_their_step_as_offline_and_bad_ones_are_counted():
+    """Paced wheel commands (with bad ones) = a gyrostat stepped offline at the same deadlines."""
+    from rigid_body_dynamics.engine import WheelCommands
+    from rigid_body_dynamics.physics.gyrostat import GyrostatIntegrator
+    clock = FakeClock()
+    t0 = clock.ns
+    rng = np.random.default_rng(8)
+    times = (np.sort(rng.uniform(0.0, 0.3e9, 30)).astype(np.int64) + t0).tolist()
+    commands = [tuple(rng.normal(scale=0.03, size=4)) for _ in times]
+    commands[5] = (0.01, 0.02)                               # wrong length
+    commands[9] = (math.nan, 0.0, 0.0, 0.0)                  # non-finite
+    wheels = _wheels()
+    body = make_body(wheels=wheels, wheel_speeds=(100.0, -50.0, 0.0, 20.0), publish_every=10)
+    pending = list(zip(times, commands))
+
+    def inbox():
+        came = [p for p in pending if p[0] <= clock.ns]
+        del pending[:len(came)]
+        return [WheelCommands([c[0] for c in came], [c[1] for c in came])] if came else []
+    pace = Pace(body, 1.0, clock=clock, perf=clock.perf, inbox=inbox)
+    out = []
+    while clock.ns < t0 + int(0.4e9):
+        clock.advance(pace.due(out) * 1e9 + rng.uniform(0, 0.3 * MS))
+    assert body.wheel_counts == {'accepted': 28, 'rejected': 2}
+    ref = GyrostatIntegrator((1.0, 2.0, 3.0), wheels, 1e-3, omega0=(0.3, 1.5, -0.4),
+                             speeds0=(100.0, -50.0, 0.0, 20.0))
+    held, k = (0.0,) * 4, 0
+    for step in range(1, body.steps + 1):
+        at = pace.anchor_ns + step * MS
+        while k < len(times) and times[k] <= at:
+            if len(commands[k]) == 4 and all(math.isfinite(c) for c in commands[k]):
+                held = commands[k]
+            k += 1
+        ref.command_motors(held)
+        ref.step()
+    assert body.steps > 350 and body.stepper.q == ref.q and body.stepper.omega == ref.omega
+    assert body.stepper.speeds == ref.speeds and body.stepper.applied == ref.applied
+    snaps = [s for s in out if getattr(s, 'wheels', None) is not None]
+    assert len(snaps) > 30 and all(len(s.wheels.speeds) == 4 for s in snaps)
+    assert body.take_events() >= {'wheel_accepted', 'wheel_rejected'}
+
+
+def test_wheel_commands_time_out_like_the_torque_and_reset_restores_the_speeds():
+    from rigid_body_dynamics.engine import WheelCommands
+    body = make_body(wheels=_wheels(), wheel_speeds=(10.0, 0.0, 0.0, 0.0), torque_timeout=0.05)
+    body.hold(body.check(WheelCommands.one((0.01, 0.0, 0.0, 0.0), 0)), 0, 1)
+    outbox = []
+    with body.lock:
+        for k in range(100):
+            body.advance(k * MS, outbox)
+    assert body.stepper.applied == (0.0,) * 4 and body.wheel_timed_out
+    assert any('wheel command timed out' in n for n in body.take_notes())
+    body.reset()
+    assert body.stepper.speeds == (10.0, 0.0, 0.0, 0.0) and body.wheel_held is None
+
+
+def test_lockstep_with_wheels_a_wheel_command_answers_the_tick():
+    """Bit for bit: the state after three ticks equals a gyrostat stepped offline with them."""
+    from rigid_body_dynamics.engine import Lockstep, WheelCommands
+    from rigid_body_dynamics.physics.gyrostat import GyrostatIntegrator
+    clock = FakeClock()
+    wheels = _wheels()
+    body = make_body(wheels=wheels, torque_timeout=0.0, publish_every=5)
+    lock = Lockstep(body, control_every=10, timeout=0.0, clock=clock, perf=clock.perf)
+    outbox = []
+    sent = [(0.01, 0.0, -0.01, 0.02), (0.0, 0.03, 0.0, 0.0), (-0.02, 0.0, 0.0, 0.01)]
+    for u in sent:
+        lock.due(outbox)
+        steps = body.steps
+        lock.mailbox.put(WheelCommands.one(u, clock()))
+        lock.due(outbox)
+        assert body.steps == steps + 10
+    ref = GyrostatIntegrator((1.0, 2.0, 3.0), wheels, 1e-3, omega0=(0.3, 1.5, -0.4),
+                             speeds0=(0.0,) * 4)
+    for u in sent:
+        ref.command_motors(u)
+        for _ in range(10):
+            ref.step()
+    assert body.stepper.q == ref.q and body.stepper.speeds == ref.speeds and lock.ticks == 3

@@ -13,10 +13,10 @@ plumbing in ``ros/``) are the ROS side around them.
 """
 
 from .body import BodySimulation, Disturbances, ImuSample, Snapshot, TorqueCommand
-from .commands import Mailbox, TorqueCommands
+from .commands import Mailbox, TorqueCommands, WheelCommands
 from .lockstep import Lockstep
 from .loop import Loop, Member
 from .pacer import Pace
 
 __all__ = ['BodySimulation', 'Disturbances', 'ImuSample', 'Lockstep', 'Loop', 'Mailbox', 'Member',
-           'Pace', 'Snapshot', 'TorqueCommand', 'TorqueCommands']
+           'Pace', 'Snapshot', 'TorqueCommand', 'TorqueCommands', 'WheelCommands']

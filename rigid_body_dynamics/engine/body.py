@@ -25,6 +25,7 @@ import numpy as np
 
 from .commands import TorqueCommands
 from ..physics import make_integrator, quaternions
+from ..physics.gyrostat import GyrostatIntegrator
 from ..physics.disturbances import GravityGradient
 from ..physics.sensors import GyroErrors, GyroModel
 
@@ -34,6 +35,8 @@ _NS = 1_000_000_000
 #: Counters of torque commands, in the order diagnostics list them.
 COUNTS = ('accepted', 'rejected_non_finite', 'rejected_frame', 'clipped', 'force_ignored',
           'stale')
+#: Counters of wheel commands (wheel_cmd), in the order diagnostics list them.
+WHEEL_COUNTS = ('accepted', 'rejected')
 
 
 @dataclass(frozen=True)
@@ -89,6 +92,19 @@ class ImuSample(NamedTuple):
     orientation_variance: float
 
 
+class WheelState(NamedTuple):
+    """
+    The reaction wheels at a tick: ``speeds`` (rad/s relative to the body), ``angles``
+    (rad), the motor torques ``applied`` over the last step after the limits (N m), and
+    the wheels' angular momentum ``momentum_principal`` (kg m^2/s, principal frame).
+    """
+
+    speeds: tuple
+    angles: tuple
+    applied: tuple
+    momentum_principal: tuple
+
+
 class Snapshot(NamedTuple):
     """
     What one publish tick needs, taken under the lock.
@@ -108,6 +124,7 @@ class Snapshot(NamedTuple):
     torque_principal: tuple
     inertia: object
     odom_only: bool = False    # lockstep's tick state between publish ticks: odom (and clock, TF)
+    wheels: object = None      # a WheelState when the body has reaction wheels
 
 
 #: Up to this many commands are checked one by one in plain Python, more as arrays: numpy's
@@ -183,6 +200,36 @@ def _check_arrays(commands, limit):
     return v.tolist(), bad, over, pushed, newest
 
 
+class CheckedWheels:
+    """
+    Wheel commands checked at once: each valid (``count`` finite numbers) or refused.
+
+    Made by :meth:`BodySimulation.check`, read by :meth:`BodySimulation.hold`: the
+    vectors, the running count of refused commands before each index, and the
+    newest valid index at or before each.
+    """
+
+    kind = 'wheels'
+
+    def __init__(self, commands, count):
+        self.received_ns, self.stamps_ns = commands.received_ns, None
+        self.vectors, self.bad, self.newest = [], [0], []
+        last = -1
+        for i, torques in enumerate(commands.torques):
+            try:
+                v = tuple(float(c) for c in torques)
+            except (TypeError, ValueError):
+                v = ()
+            ok = len(v) == count and all(math.isfinite(c) for c in v)
+            self.vectors.append(v)
+            self.bad.append(self.bad[-1] + (not ok))
+            last = i if ok else last
+            self.newest.append(last)
+
+    def __len__(self):
+        return len(self.received_ns)
+
+
 class BodySimulation:
     """
     The state of one simulated body and the rules for changing it.
@@ -193,7 +240,11 @@ class BodySimulation:
     axis; 0 = no limit), ``publish_every`` (steps per publish tick), ``imu_every``
     (steps per gyro sample, 0 = none), ``gyro`` (GyroErrors; None = perfect) and
     its ``seed``, ``start_ns`` (stamp of simulated time 0), ``disturbances``
-    (:class:`Disturbances`; None = none). ``notes`` collects what a node should
+    (:class:`Disturbances`; None = none), ``wheels`` (a
+    :class:`~rigid_body_dynamics.physics.gyrostat.Wheels` in the body frame, or None)
+    and their ``wheel_speeds`` at the start (rad/s; default 0): with wheels the body is
+    a gyrostat and its motor torques are commands of their own (``WheelCommands``),
+    held and timed out like the torque. ``notes`` collects what a node should
     log (the watchdog's timeouts, lockstep's misses), drained with
     :meth:`take_notes`; ``events`` the command events since the last
     :meth:`take_events` (for the node's warnings).
@@ -214,7 +265,7 @@ class BodySimulation:
 
     def __init__(self, inertia, integrator, rate, initial, torque_timeout=0.5, max_torque=0.0,
                  publish_every=1, start_ns=0, imu_every=0, gyro=None, seed=0,
-                 disturbances=None):
+                 disturbances=None, wheels=None, wheel_speeds=None):
         self.lock = threading.RLock()
         self.rate = float(rate)
         self.dt = 1.0 / self.rate
@@ -230,6 +281,10 @@ class BodySimulation:
         self.gyro_errors = gyro if gyro is not None else GyroErrors()
         self.seed = int(seed)
         self.disturbances = disturbances or Disturbances()
+        self.wheels = wheels if wheels is not None and wheels.count else None
+        n = self.wheels.count if self.wheels is not None else 0
+        self.wheel_speeds0 = tuple(float(v) for v in wheel_speeds) if wheel_speeds else (0.0,) * n
+        self.wheel_counts = dict.fromkeys(WHEEL_COUNTS, 0)
         self.counts = dict.fromkeys(COUNTS, 0)
         self.notes = []
         self.events = set()
@@ -241,18 +296,38 @@ class BodySimulation:
         with self.lock:
             q0, w0 = self.initial
             body = self.inertia
-            self.stepper = make_integrator(self.integrator_name, body.moments, self.dt,
-                                           body.attitude_to_principal(np.asarray(q0, float)),
-                                           body.to_principal(np.asarray(w0, float)))
+            self.stepper = self._make_stepper(body.attitude_to_principal(np.asarray(q0, float)),
+                                              body.to_principal(np.asarray(w0, float)),
+                                              self.wheel_speeds0)
             self.steps = 0
             self.paused = False
             self.command_held = None
             self.timed_out = False
+            self.wheel_held = None
+            self.wheel_timed_out = False
             self._held = (_ZERO, None, None)
             self.gyro = GyroModel(self.gyro_errors, self.rate / max(self.imu_every, 1),
                                   self.seed)     # same seed: the same stream after a reset
             self._disturb()
             self._baseline()
+
+    def _make_stepper(self, q_principal, omega_principal, speeds=None, angles=None):
+        """
+        Return the stepper of the state given in the principal frame (call under lock).
+
+        A gyrostat (order 8, or RK4 for integrator ``rk4``) when the body has wheels.
+        """
+        if self.wheels is None:
+            return make_integrator(self.integrator_name, self.inertia.moments, self.dt,
+                                   q_principal, omega_principal)
+        turn = self.inertia.to_principal
+        stepper = GyrostatIntegrator(
+            self.inertia.moments, self.wheels.turned(lambda g: turn(np.array(g))), self.dt,
+            q_principal, omega_principal, speeds,
+            method='rk4' if self.integrator_name == 'rk4' else 'exact')
+        if angles is not None:
+            stepper.angles = tuple(angles)
+        return stepper
 
     def _disturb(self):
         """Set up the disturbances for the current inertia and stepper (call under lock)."""
@@ -330,8 +405,9 @@ class BodySimulation:
                 rebuild = True
                 lines.append(f'integrator now {integrator}, continuing from the current state')
             if rebuild:
-                self.stepper = make_integrator(self.integrator_name, self.inertia.moments,
-                                               self.dt, self.stepper.q, self.stepper.omega)
+                old = self.stepper
+                self.stepper = self._make_stepper(old.q, old.omega, getattr(old, 'speeds', None),
+                                                  getattr(old, 'angles', None))
                 self._disturb()
                 self._baseline()
                 cmd = self.command_held
@@ -359,6 +435,8 @@ class BodySimulation:
         with self.lock:
             if commands.kind == 'torque':
                 return CheckedTorques(commands, self.max_torque)
+            if commands.kind == 'wheels':
+                return CheckedWheels(commands, self.wheels.count if self.wheels else 0)
             raise ValueError(f'unknown kind of command {commands.kind!r}')
 
     def hold(self, checked, start, stop):
@@ -371,6 +449,8 @@ class BodySimulation:
         ``stop - 1``. Returns the set of events, which are also kept for
         :meth:`take_events`. Takes the lock.
         """
+        if checked.kind == 'wheels':
+            return self._hold_wheels(checked, start, stop)
         events = set()
         with self.lock:
             counts = self.counts
@@ -396,6 +476,41 @@ class BodySimulation:
                     None if checked.stamps_ns is None else checked.stamps_ns[i])
             self.events |= events
         return events
+
+    def _hold_wheels(self, checked, start, stop):
+        """Count wheel commands start:stop and hold the newest valid one (see hold)."""
+        events = set()
+        with self.lock:
+            bad = checked.bad[stop] - checked.bad[start]
+            if bad:
+                self.wheel_counts['rejected'] += bad
+                events.add('wheel_rejected')
+            if stop - start - bad:
+                self.wheel_counts['accepted'] += stop - start - bad
+                events.add('wheel_accepted')
+                self.wheel_held = (checked.vectors[checked.newest[stop - 1]],
+                                   checked.received_ns[stop - 1])
+            self.events |= events
+        return events
+
+    def motor_torques_now(self, now_ns):
+        """
+        Return the held motor torques (N m) for the next step, zero once timed out.
+
+        The wheels' watchdog, as :meth:`torque_now` for the torque (the same
+        ``torque_timeout``; a note says so once). Call under ``lock``.
+        """
+        held = self.wheel_held
+        if held is None:
+            return (0.0,) * self.wheels.count
+        if self.timeout_ns and now_ns - held[1] > self.timeout_ns:
+            if not self.wheel_timed_out:
+                self.wheel_timed_out = True
+                self.notes.append('wheel command timed out: motor torques are zero until the '
+                                  'next wheel_cmd')
+            return (0.0,) * self.wheels.count
+        self.wheel_timed_out = False
+        return held[0]
 
     def command(self, vector, world, now_ns, force=_ZERO, stamp_ns=None):
         """
@@ -471,6 +586,12 @@ class BodySimulation:
         field = self._field
         torqued = (field is not None or torque_world is not None or torque[0] or torque[1]
                    or torque[2])
+        if self.wheels is not None:
+            motors = self.motor_torques_now(now_ns)
+            self.stepper.command_motors(motors)
+            # motor torques and friction change T (not H): no free-motion drift baseline
+            torqued = torqued or any(motors) or any(self.wheels.coulomb) or \
+                any(self.wheels.viscous)
         if self._base_stale and not torqued:
             self._baseline()          # the state after the last step under torque
         self.stepper.step(torque, torque_world, field)
@@ -499,7 +620,7 @@ class BodySimulation:
         and items as ``count`` calls of :meth:`advance`.
         """
         if self._dist_body is not None or self._dist_world is not None or \
-                self._field is not None:
+                self._field is not None or self.wheels is not None:
             return False
         if self.command_held is not None:
             self.torque_now(now_ns)            # the watchdog, as the first step would ask it
@@ -562,8 +683,10 @@ class BodySimulation:
     def snapshot(self, odom_only=False):
         """Take the current :class:`Snapshot` (call under ``lock``)."""
         s = self.stepper
+        wheels = None if self.wheels is None else WheelState(
+            s.speeds, s.angles, s.applied, s.wheel_momentum_body)
         return Snapshot(self.stamp_now(), self.steps, s.q, s.omega,
-                        self.last_torque, self.inertia, odom_only)
+                        self.last_torque, self.inertia, odom_only, wheels)
 
     # ------------------------------------------------------------------ diagnostics
     def health(self):
@@ -590,4 +713,16 @@ class BodySimulation:
                 'direction drift': math.atan2(float(np.linalg.norm(np.cross(l0, l1))),
                                               float(np.dot(l0, l1))),
                 'work': s.work, 'command': self.command_held, 'timed_out': self.timed_out,
-                'paused': self.paused, 'counts': dict(self.counts)}
+                'paused': self.paused, 'counts': dict(self.counts),
+                'wheels': None if self.wheels is None else self._wheel_health()}
+
+    def _wheel_health(self):
+        """The wheels' numbers for diagnostics (call under ``lock``)."""
+        s, w = self.stepper, self.wheels
+        return {'speeds': s.speeds,
+                'speed fractions': tuple(abs(v) / top if top else 0.0
+                                         for v, top in zip(s.speeds, w.max_speed)),
+                'applied': s.applied, 'clipped': tuple(s.clipped), 'cut off': tuple(s.cut),
+                'command': self.wheel_held, 'timed_out': self.wheel_timed_out,
+                'counts': dict(self.wheel_counts), 'motor work': s.motor_work,
+                'friction loss': s.friction_loss}

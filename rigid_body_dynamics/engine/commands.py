@@ -15,7 +15,8 @@ possible, lockstep, a fleet's bodies):
 
 A new kind of command is a new value class (with ``kind``, ``received_ns``,
 ``stamps_ns``, ``__len__`` and ``select``) and its decoder, and the body's rule for
-it; the paces do not change. :class:`Mailbox` is an inbox for code without ROS
+it; the paces do not change. :class:`WheelCommands` (reaction-wheel motor torques)
+was added that way. :class:`Mailbox` is an inbox for code without ROS
 (tests, a Python controller in the same process).
 """
 
@@ -108,3 +109,39 @@ class Mailbox:
     def wake(self):
         """Wake a :meth:`wait` now (stopping)."""
         self._arrived.set()
+
+
+class WheelCommands:
+    """
+    N reaction-wheel commands, oldest first (kind ``'wheels'``): motor torques, N m.
+
+    ``received_ns``: steady-clock receive times (int ns, non-decreasing);
+    ``torques``: N sequences, each meant to hold one motor torque per wheel (a
+    wrong length or a non-finite value is refused and counted by the body);
+    ``stamps_ns``: None (std_msgs/Float64MultiArray has no header).
+    """
+
+    kind = 'wheels'
+    __slots__ = ('received_ns', 'torques', 'stamps_ns')
+
+    def __init__(self, received_ns, torques, stamps_ns=None):
+        self.received_ns = received_ns
+        self.torques = torques
+        self.stamps_ns = stamps_ns
+        if len(torques) != len(received_ns):
+            raise ValueError(f'{len(received_ns)} receive times, {len(torques)} commands: '
+                             'lengths differ')
+
+    @classmethod
+    def one(cls, torques, received_ns):
+        """Return a single command: ``torques`` (n motor torques, N m)."""
+        return cls((int(received_ns),), (tuple(torques),))
+
+    def __len__(self):
+        return len(self.received_ns)
+
+    def select(self, keep):
+        """Return the commands where the boolean sequence ``keep`` is true, in order."""
+        index = [i for i, k in enumerate(keep) if k]
+        return WheelCommands([self.received_ns[i] for i in index],
+                             [self.torques[i] for i in index])

@@ -59,6 +59,7 @@ class Lockstep(Pace):
         self.wait_ns = self.max_wait_ns = 0
         self._first = True
         self._streak = 0
+        self._wheel_answer = False
         self._wait_start = self._last_repeat = self.clock()
 
     def set_rtf(self, rtf):
@@ -70,11 +71,14 @@ class Lockstep(Pace):
 
         A dropped command is counted ``stale`` (an answer that came after its tick
         was closed: using it would make the run depend on timing); one without a
-        stamp cannot answer a tick and is held as in real time.
+        stamp is held as in real time. Wheel commands (std_msgs/Float64MultiArray:
+        no stamp) answer the tick during whose wait they come.
         """
         body, taken = self.body, []
         now = body.stamp_now()
         for value in self.inbox():
+            if value.kind == 'wheels' and len(value):
+                self._wheel_answer = True
             if value.stamps_ns is not None:
                 fresh = [s >= now for s in value.stamps_ns]
                 if not all(fresh):
@@ -98,11 +102,12 @@ class Lockstep(Pace):
             now = self.clock()
             self._hold_all()
             cmd = body.command_held
-            answered = cmd is not None and cmd.stamp_ns is not None and \
-                cmd.stamp_ns >= body.stamp_now()
+            answered = self._wheel_answer or (cmd is not None and cmd.stamp_ns is not None
+                                              and cmd.stamp_ns >= body.stamp_now())
             waited = now - self._wait_start
             if answered or (not self._first and self.timeout_ns and waited > self.timeout_ns):
                 self._close_tick(answered, waited)
+                self._wheel_answer = False
                 for _ in range(self.control_every):
                     body.advance(now, outbox)
                 if body.steps % body.publish_every:     # the state at the tick always goes out

@@ -96,6 +96,11 @@ SIMULATOR = Interfaces('attitude_simulator', [
               'until replaced or `torque_timeout`; non-finite values and unknown frames are '
               'refused and counted. Reliable, depth 1000, taken in batches by the integration '
               'thread (held by the hidden helper node `_attitude_simulator_intake`).'),
+    Interface('sub', 'wheel_cmd', 'std_msgs/msg/Float64MultiArray',
+              'Reaction-wheel motor torques (N m), one per wheel in `wheel_axes` order; held '
+              'and timed out like `torque_cmd`; a wrong length or a non-finite value is '
+              'refused and counted. In lockstep a wheel_cmd answers the tick it comes in.',
+              'if `wheel_axes` is set'),
     Interface('pub', 'odom', 'nav_msgs/msg/Odometry',
               '`world_frame` -> `body_frame`: orientation body -> world, twist.angular = omega '
               '(rad/s, body frame); position 0.'),
@@ -104,12 +109,18 @@ SIMULATOR = Interfaces('attitude_simulator', [
     Interface('pub', 'angular_velocity', 'geometry_msgs/msg/Vector3Stamped',
               'omega (rad/s), `body_frame`.', 'if in `state_topics`'),
     Interface('pub', 'angular_momentum', 'geometry_msgs/msg/Vector3Stamped',
-              'L (kg m^2/s), `world_frame`; constant when torque-free.', 'if in `state_topics`'),
+              'L (kg m^2/s), `world_frame`; constant when torque-free. With wheels the total '
+              'H = I omega + sum J Omega g.', 'if in `state_topics`'),
     Interface('pub', 'angular_momentum_body', 'geometry_msgs/msg/Vector3Stamped',
-              'L (kg m^2/s), `body_frame`.', 'if in `state_topics`'),
+              'L (kg m^2/s), `body_frame`; with wheels the total H.', 'if in `state_topics`'),
     Interface('pub', 'applied_torque', 'geometry_msgs/msg/WrenchStamped',
               'The body-frame torque (N m) held over the step that ended at the stamp: the '
-              'command (zero after a timeout) plus disturbances.', 'if in `state_topics`'),
+              'command (zero after a timeout) plus disturbances: the external torque (motor '
+              'torques are internal).', 'if in `state_topics`'),
+    Interface('pub', 'wheel_state', 'sensor_msgs/msg/JointState',
+              'The wheels at the odom stamp: name `wheel_0`.., position the wheel angle (rad), '
+              'velocity Omega (rad/s relative to the body), effort the motor torque applied '
+              'after the limits (N m).', 'if `wheel_axes` is set'),
     Interface('pub', 'imu', 'sensor_msgs/msg/Imu',
               'REP 145 gyro at `imu_rate`: measured angular velocity and orientation with the '
               'gyro error model and their covariances; no acceleration (covariance[0] = -1).',
@@ -124,7 +135,8 @@ SIMULATOR = Interfaces('attitude_simulator', [
               "`world_frame` -> `body_frame` at every odom stamp (rotation only); tf2_ros' "
               'broadcaster QoS.', 'if `publish_tf` and tf2_msgs is importable'),
     Interface('pub', '/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray',
-              '1 Hz: `<node>: integrator` and `<node>: torque command` statuses.'),
+              '1 Hz: `<node>: integrator` and `<node>: torque command` statuses (and '
+              '`<node>: reaction wheels` with wheels).'),
     Interface('pub', '~/real_time_factor', 'std_msgs/msg/Float64',
               'Achieved real-time factor, 1 Hz (simulated over wall time between wakes; 0 '
               'while paused).'),

@@ -41,7 +41,7 @@ import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
-from std_msgs.msg import Float64
+from std_msgs.msg import Float64, Float64MultiArray
 from std_srvs.srv import SetBool, Trigger
 
 from .simulator_diagnostics import SimulatorReport
@@ -49,7 +49,7 @@ from .simulator_parameters import PARAMETERS, state_topics
 from ..engine import BodySimulation, Lockstep, Loop, Member, Pace
 from ..physics import presets
 from ..physics.sensors import GyroErrors
-from ..ros.command_decoder import steady_times, TorqueDecoder
+from ..ros.command_decoder import decode_wheels, steady_times, TorqueDecoder
 from ..ros.intake import Intake
 from ..ros.runner import run
 from ..ros.state_publisher import StatePublisher, tf_available
@@ -136,14 +136,15 @@ class AttitudeSimulator(Node):
             gyro=GyroErrors(values['gyro_noise_density'], values['gyro_bias_random_walk'],
                             values['gyro_turn_on_bias'], values['gyro_bias_correlation_time'],
                             values['orientation_noise'], values['gyro_resolution']),
-            seed=values['noise_seed'], disturbances=values['disturbances'])
+            seed=values['noise_seed'], disturbances=values['disturbances'],
+            wheels=values['wheels'], wheel_speeds=values['wheel_speeds'])
         self._publish_rate = values['publish_rate']
         self._decoder = TorqueDecoder(self._frames)
         self._refused_frame = ''
         if self.lockstep:
             self.pace = Lockstep(self.body, values['control_every'], values['lockstep_timeout'],
                                  inbox=self._inbox,
-                                 wait=lambda timeout: self._intake.wait('torque_cmd', timeout))
+                                 wait=lambda timeout: self._intake.wait(self._commands, timeout))
         else:
             self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog,
                              inbox=self._inbox)
@@ -167,6 +168,11 @@ class AttitudeSimulator(Node):
             f'{rate:g} Hz, publishing at {self._publish_rate:g} Hz, {pacing}')
         if values['disturbances'].active:
             self.get_logger().info(f'disturbances: {values["disturbances"]}')
+        if self.body.wheels is not None:
+            w = self.body.wheels
+            self.get_logger().info(
+                f'{w.count} reaction wheels: axes {[list(g) for g in w.axes]}, J {list(w.inertia)} '
+                f'kg m^2, speeds {list(self.body.wheel_speeds0)} rad/s; motor torques on wheel_cmd')
 
     # ------------------------------------------------------------------ parameters
     def _on_set_parameters(self, params):
@@ -207,7 +213,8 @@ class AttitudeSimulator(Node):
         self.state = StatePublisher(
             self, self._frames, publish_imu=self.get_parameter('publish_imu').value,
             publish_clock=self._publish_clock, publish_tf=publish_tf,
-            topics=state_topics(self.get_parameter('state_topics').value))
+            topics=state_topics(self.get_parameter('state_topics').value),
+            wheels=self.body.wheels.count if self.body.wheels is not None else 0)
         if publish_tf and not tf_available():
             self.get_logger().info('publish_tf: tf2_msgs is not importable here (no tf2_msgs '
                                    'wheel exists; on a ROS install it is), so /tf is not '
@@ -217,6 +224,10 @@ class AttitudeSimulator(Node):
         # the integration thread takes its commands itself: no executor hop, no callback each
         self._intake = Intake(self)
         self._intake.subscribe(WrenchStamped, 'torque_cmd', TORQUE_QOS, overridable=True)
+        self._commands = ('torque_cmd',)
+        if self.body.wheels is not None:
+            self._intake.subscribe(Float64MultiArray, 'wheel_cmd', TORQUE_QOS, overridable=True)
+            self._commands += ('wheel_cmd',)
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
 
@@ -229,15 +240,21 @@ class AttitudeSimulator(Node):
         commands in an unknown frame are counted here, everything else is the
         engine's (:meth:`BodySimulation.hold`).
         """
+        out = []
         received = []
         raws = self._intake.take('torque_cmd', received=received)
-        if not raws:
-            return ()
-        commands, refused = self._decoder.decode(raws, steady_times(received))
-        for frame, count in refused.items():
-            self._refused_frame = frame
-            self.body.reject('rejected_frame', count)
-        return (commands,)
+        if raws:
+            commands, refused = self._decoder.decode(raws, steady_times(received))
+            for frame, count in refused.items():
+                self._refused_frame = frame
+                self.body.reject('rejected_frame', count)
+            out.append(commands)
+        if len(self._commands) > 1:
+            received = []
+            raws = self._intake.take('wheel_cmd', received=received)
+            if raws:
+                out.append(decode_wheels(raws, steady_times(received)))
+        return out
 
     def _warn_events(self, events):
         """Warn (throttled) about the command events the body reported."""
@@ -255,6 +272,9 @@ class AttitudeSimulator(Node):
         if 'force_ignored' in events:
             warn('force', 'torque_cmd carries a force; only the torque is used (the body '
                  'does not translate)', period=math.inf)
+        if 'wheel_rejected' in events:
+            warn('wheel', f'wheel_cmd rejected: it needs {self.body.wheels.count} finite motor '
+                 'torques (N m, one per wheel); state unchanged')
         if 'stale' in events:
             warn('stale', 'lockstep: torque_cmd stamped before the current tick dropped '
                  '(an answer that came after its tick was missed)')

@@ -5,6 +5,8 @@ The /diagnostics of attitude_simulator: two statuses per period, integrator and 
 factor, missed deadlines and lateness, quaternion norm error, drift since the
 last torque, work, and in lockstep the answered and missed ticks and the wait
 per tick. ``torque command``: age, timeout, frame, vector and the counters.
+``reaction wheels`` (with wheels): speeds, speed over limit, motor torques applied,
+the held command, clipped and cut-off steps, motor work, friction loss, counters.
 """
 
 import math
@@ -27,8 +29,35 @@ class SimulatorReport:
         self._misses_seen = 0
 
     def statuses(self, name, hardware_id):
-        """Return [integrator, torque command] DiagnosticStatus for node ``name``."""
-        return [self._integrator(name, hardware_id), self._torque(name, hardware_id)]
+        """Return [integrator, torque command (, reaction wheels)] DiagnosticStatus of ``name``."""
+        out = [self._integrator(name, hardware_id), self._torque(name, hardware_id)]
+        if self._health['wheels'] is not None:
+            out.append(self._wheels(name, hardware_id))
+        return out
+
+    def _wheels(self, name, hw):
+        w = self._health['wheels']
+        counts, held = w['counts'], w['command']
+        worst = max(w['speed fractions'], default=0.0)
+        if worst >= 1.0:
+            level, message = DiagnosticStatus.WARN, 'a wheel is at its speed limit'
+        elif w['timed_out']:
+            level, message = DiagnosticStatus.WARN, 'wheel command timed out: motors at 0'
+        else:
+            level, message = DiagnosticStatus.OK, ('no wheel command received' if held is None
+                                                   else 'holding the last wheel command')
+        if counts['rejected']:
+            message += f'; {counts["rejected"]} rejected'
+        return status(f'{name}: reaction wheels', level, message, [
+            ('wheel speeds (rad/s)', list(w['speeds'])),
+            ('speed / limit', list(w['speed fractions'])),
+            ('motor torques applied (N m)', list(w['applied'])),
+            ('command (N m)', 'none' if held is None else list(held[0])),
+            ('timed out', w['timed_out']),
+            ('clipped steps', list(w['clipped'])), ('cut-off steps', list(w['cut off'])),
+            ('motor work since reset (J)', w['motor work']),
+            ('friction loss since reset (J)', w['friction loss']),
+            ('accepted', counts['accepted']), ('rejected', counts['rejected'])], hw)
 
     def _integrator(self, name, hw):
         body, pace = self.body, self.pace

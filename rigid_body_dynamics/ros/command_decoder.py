@@ -1,21 +1,23 @@
 """
-torque_cmd messages -> the engine's command values, and the frame rule of a torque, in one place.
+Command messages -> the engine's command values, and the frame rule of a torque, in one place.
 
 The simulator's integration thread takes the serialised messages pending on
 ``torque_cmd`` (:class:`~.intake.Intake`) and :class:`TorqueDecoder` turns them
 into one :class:`~rigid_body_dynamics.engine.commands.TorqueCommands`: read in one
 go with :mod:`rigid_body_dynamics.messages.cdr` when they share a frame id (a flood costs
-little), else deserialised one by one. Everything after that (checks, counts,
-the held command, its timing) is the engine's.
+little), else deserialised one by one; :func:`decode_wheels` turns ``wheel_cmd``
+(std_msgs/Float64MultiArray) into :class:`~rigid_body_dynamics.engine.commands.WheelCommands`.
+Everything after that (checks, counts, the held command, its timing) is the engine's.
 """
 
 import time
 
 from geometry_msgs.msg import WrenchStamped
 from rclpy.serialization import deserialize_message
+from std_msgs.msg import Float64MultiArray
 
 from . import conversions as conv
-from ..engine.commands import TorqueCommands
+from ..engine.commands import TorqueCommands, WheelCommands
 from ..messages import cdr
 
 
@@ -80,3 +82,15 @@ class TorqueDecoder:
             [k[0] for k in kept], [conv.vector_array(k[1].wrench.torque) for k in kept],
             [k[2] for k in kept], [conv.time_ns(k[1].header.stamp) for k in kept],
             [conv.vector_array(k[1].wrench.force) for k in kept]), refused
+
+
+def decode_wheels(raws, received_ns):
+    """
+    Return the WheelCommands of serialised std_msgs/Float64MultiArray ``raws``.
+
+    Each message's ``data`` is one command (n motor torques, N m); its layout is not
+    read. ``received_ns``: steady receive times (int ns), oldest first.
+    """
+    return WheelCommands(list(received_ns),
+                         [tuple(deserialize_message(raw, Float64MultiArray).data)
+                          for raw in raws])

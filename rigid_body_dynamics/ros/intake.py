@@ -16,6 +16,7 @@ take() or wait set; these are the calls its executor makes
 one tested place.
 """
 
+import contextlib
 import copy
 
 import rclpy
@@ -50,16 +51,26 @@ class Intake:
         self._subs[topic] = self.node.create_subscription(
             msg_type, topic, lambda _msg: None, qos, raw=True)
 
-    def wait(self, topic, timeout):
-        """Block until a message is pending on ``topic`` or ``timeout`` s pass; whether one is."""
-        sub = self._subs[topic]
+    def wait(self, topics, timeout):
+        """
+        Block until a message is pending on one of ``topics`` or ``timeout`` s pass.
+
+        ``topics``: a topic name or a tuple of them. Returns whether one is pending.
+        """
+        topics = (topics,) if isinstance(topics, str) else tuple(topics)
+        subs = [self._subs[t] for t in topics]
         context = self.node.context
-        with sub.handle, context.handle:
-            waits = self._waits.get(topic)
+        with contextlib.ExitStack() as stack:
+            for sub in subs:
+                stack.enter_context(sub.handle)
+            stack.enter_context(context.handle)
+            waits = self._waits.get(topics)
             if waits is None:
-                waits = self._waits[topic] = _rclpy.WaitSet(1, 0, 0, 0, 0, 0, context.handle)
+                waits = self._waits[topics] = _rclpy.WaitSet(len(subs), 0, 0, 0, 0, 0,
+                                                              context.handle)
             waits.clear_entities()
-            waits.add_subscription(sub.handle)
+            for sub in subs:
+                waits.add_subscription(sub.handle)
             waits.wait(max(0, int(timeout * 1e9)))
             return bool(waits.get_ready_entities('subscription'))
 

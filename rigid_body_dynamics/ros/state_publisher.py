@@ -23,7 +23,7 @@ import numpy as np
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions
 from rosgraph_msgs.msg import Clock as ClockMsg
-from sensor_msgs.msg import Imu
+from sensor_msgs.msg import Imu, JointState
 
 from . import conversions as conv
 from .prepacked import Prepacked
@@ -67,7 +67,7 @@ class StatePublisher:
     """
 
     def __init__(self, node, frames, publish_imu=True, publish_clock=False, publish_tf=False,
-                 topics=OPTIONAL_TOPICS):
+                 topics=OPTIONAL_TOPICS, wheels=0):
         self.world_frame, self.body_frame = frames
         qos_opts = QoSOverridingOptions.with_default_policies()
 
@@ -105,6 +105,9 @@ class StatePublisher:
                                               'angular_velocity_covariance'))
             self._bias_bytes = _stamped(Vector3Stamped(), body, 'vector')
         self._inertia = pub(InertiaStamped, 'inertia', LATCHED_QOS)
+        self._wheel_state = pub(JointState, 'wheel_state') if wheels else None
+        if wheels:
+            self._joints = JointState(name=[f'wheel_{i}' for i in range(wheels)])
         self._clock = node.create_publisher(ClockMsg, '/clock', CLOCK_QOS) \
             if publish_clock else None
         if self._clock is not None:
@@ -141,8 +144,11 @@ class StatePublisher:
         inertia = snapshot.inertia
         if self._orientation is not None:
             self._orientation.publish(self._orientation_bytes.pack(stamp, q_b))
+        wheels = snapshot.wheels
         if self._vectors:
             m_p = tuple(i * w for i, w in zip(inertia.moments, snapshot.omega_principal))
+            if wheels is not None:          # H = I omega + sum J Omega g: the whole gyrostat
+                m_p = tuple(a + b for a, b in zip(m_p, wheels.momentum_principal))
             vectors = {'omega': w_b,
                        'l_world': quaternions.rotate_components(snapshot.q_principal, m_p),
                        'l_body': m_p if inertia.is_principal_frame else
@@ -153,6 +159,12 @@ class StatePublisher:
             torque = snapshot.torque_principal if inertia.is_principal_frame else \
                 inertia.to_body(np.array(snapshot.torque_principal))
             self._torque.publish(self._torque_bytes.pack(stamp, torque))
+        if wheels is not None and self._wheel_state is not None:
+            joints = self._joints
+            joints.header.stamp = conv.time_msg(stamp)
+            joints.position, joints.velocity = list(wheels.angles), list(wheels.speeds)
+            joints.effort = list(wheels.applied)
+            self._wheel_state.publish(joints)
 
     @property
     def broadcasts_tf(self):
