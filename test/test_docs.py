@@ -118,7 +118,9 @@ def test_pages_open_from_disk_without_errors_and_the_math_is_rendered(built, tmp
 def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs_env):
     """Every topic, service and parameter of the four nodes, as the graph shows them."""
     env = tf2_msgs_env               # so /tf is there too (publish_tf is on by default)
-    modules = {'attitude_simulator': ('simulator', ['-p', 'publish_clock:=true']),
+    modules = {'attitude_simulator': ('simulator', ['-p', 'publish_clock:=true',
+                                                    '-p', 'wheel_axes:=[0.0, 0.0, 1.0]',
+                                                    '-p', 'wheel_inertia:=[0.01]']),
                'attitude_analyzer': ('analyzer', []), 'poinsot_visualizer': ('poinsot', []),
                'attitude_controller': ('controller', [])}
     for node, (module, args) in modules.items():
@@ -127,7 +129,7 @@ def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs
               'poinsot_visualizer': poinsot.PARAMETERS,
               'attitude_controller': controller.PARAMETERS}
     for node, interfaces in NODES.items():
-        want = interfaces.resolved('/')          # publish_clock on, every other default
+        want = interfaces.resolved('/')          # publish_clock on, a wheel, other defaults
 
         def have():
             out = {kind: probe.endpoints(kind, node) for kind in ('pub', 'srv')}
@@ -235,6 +237,29 @@ def test_the_send_torque_example_turns_the_body_as_euler_says(launch, probe):
     # the torque began within the tick before `first` and ended within the one after `last`
     assert 0.1 / 1.5 * (last - first) * 1e-9 - 1e-9 < gained
     assert gained < 0.1 / 1.5 * (last - first + 2 * period) * 1e-9 + 1e-9
+
+
+def test_the_spin_wheels_example_keeps_h_and_drives_the_wheels(launch, probe):
+    """wheels.yaml and spin_wheels.py: H (world) constant to 1e-12, each wheel driven 0.01 N m."""
+    from geometry_msgs.msg import Vector3Stamped
+    import numpy as np
+    from rigid_body_dynamics.ros.conversions import vector_array
+    from sensor_msgs.msg import JointState
+    launch('rigid_body_dynamics.nodes.simulator', '--params-file',
+           str(DOC / 'examples' / 'wheels.yaml'), name='sim')
+    joints = probe.subscribe(JointState, 'wheel_state')
+    momentum = probe.subscribe(Vector3Stamped, 'angular_momentum')
+    probe.wait_for('wheel_state', 10)
+    example = subprocess.Popen([sys.executable, str(DOC / 'examples' / 'spin_wheels.py')])
+    probe.spin_until(lambda: example.poll() is not None, 30.0, 'the example to end')
+    assert example.returncode == 0
+    probe.spin_for(1.0)                                     # the timeout (0.5 s) passes
+    driven = [m for m in joints if tuple(m.effort) == (0.01,) * 4]
+    assert driven and tuple(joints[-1].effort) == (0.0,) * 4
+    # about 2 s of 0.01 N m: each wheel gains about 0.01 * 2 / J_eff rad/s (J = 0.01 kg m^2)
+    assert all(1.0 < v < 4.0 for v in joints[-1].velocity), joints[-1].velocity
+    h = np.array([vector_array(m.vector) for m in momentum])
+    assert np.max(np.abs(h - h[0])) / np.linalg.norm(h[0]) < 1e-12
 
 
 def test_the_readme_is_a_short_landing_page_whose_links_resolve():

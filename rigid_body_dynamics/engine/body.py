@@ -25,8 +25,8 @@ import numpy as np
 
 from .commands import TorqueCommands
 from ..physics import make_integrator, quaternions
-from ..physics.gyrostat import GyrostatIntegrator
 from ..physics.disturbances import GravityGradient
+from ..physics.gyrostat import GyrostatIntegrator
 from ..physics.sensors import GyroErrors, GyroModel
 
 _ZERO = (0.0, 0.0, 0.0)
@@ -94,9 +94,11 @@ class ImuSample(NamedTuple):
 
 class WheelState(NamedTuple):
     """
-    The reaction wheels at a tick: ``speeds`` (rad/s relative to the body), ``angles``
-    (rad), the motor torques ``applied`` over the last step after the limits (N m), and
-    the wheels' angular momentum ``momentum_principal`` (kg m^2/s, principal frame).
+    The reaction wheels at a tick.
+
+    ``speeds`` (rad/s relative to the body), ``angles`` (rad), the motor torques
+    ``applied`` over the last step after the limits (N m), and the wheels' angular
+    momentum ``momentum_principal`` (kg m^2/s, principal frame).
     """
 
     speeds: tuple
@@ -717,7 +719,7 @@ class BodySimulation:
                 'wheels': None if self.wheels is None else self._wheel_health()}
 
     def _wheel_health(self):
-        """The wheels' numbers for diagnostics (call under ``lock``)."""
+        """Return the wheels' numbers for diagnostics (call under ``lock``)."""
         s, w = self.stepper, self.wheels
         return {'speeds': s.speeds,
                 'speed fractions': tuple(abs(v) / top if top else 0.0

@@ -71,21 +71,22 @@ class Lockstep(Pace):
 
         A dropped command is counted ``stale`` (an answer that came after its tick
         was closed: using it would make the run depend on timing); one without a
-        stamp is held as in real time. Wheel commands (std_msgs/Float64MultiArray:
-        no stamp) answer the tick during whose wait they come.
+        stamp is held as in real time. A valid wheel command (std_msgs/Float64MultiArray:
+        no stamp) answers the tick during whose wait it comes.
         """
         body, taken = self.body, []
         now = body.stamp_now()
         for value in self.inbox():
-            if value.kind == 'wheels' and len(value):
-                self._wheel_answer = True
             if value.stamps_ns is not None:
                 fresh = [s >= now for s in value.stamps_ns]
                 if not all(fresh):
                     body.reject('stale', fresh.count(False))
                     value = value.select(fresh)
             if len(value):
-                taken.append([body.check(value), 0])
+                checked = body.check(value)
+                if checked.kind == 'wheels' and checked.newest[-1] >= 0:
+                    self._wheel_answer = True
+                taken.append([checked, 0])
         return taken
 
     def due(self, outbox):

@@ -171,8 +171,9 @@ class AttitudeSimulator(Node):
         if self.body.wheels is not None:
             w = self.body.wheels
             self.get_logger().info(
-                f'{w.count} reaction wheels: axes {[list(g) for g in w.axes]}, J {list(w.inertia)} '
-                f'kg m^2, speeds {list(self.body.wheel_speeds0)} rad/s; motor torques on wheel_cmd')
+                f'{w.count} reaction wheels: axes {[list(g) for g in w.axes]}, J '
+                f'{list(w.inertia)} kg m^2, speeds {list(self.body.wheel_speeds0)} rad/s; motor '
+                'torques on wheel_cmd')
 
     # ------------------------------------------------------------------ parameters
     def _on_set_parameters(self, params):

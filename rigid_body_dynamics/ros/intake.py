@@ -66,8 +66,8 @@ class Intake:
             stack.enter_context(context.handle)
             waits = self._waits.get(topics)
             if waits is None:
-                waits = self._waits[topics] = _rclpy.WaitSet(len(subs), 0, 0, 0, 0, 0,
-                                                              context.handle)
+                waits = _rclpy.WaitSet(len(subs), 0, 0, 0, 0, 0, context.handle)
+                self._waits[topics] = waits
             waits.clear_entities()
             for sub in subs:
                 waits.add_subscription(sub.handle)
