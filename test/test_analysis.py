@@ -207,7 +207,47 @@ def _cases():
     run = simulate((1.0, 2.0, 3.0), (2.0, 0.1, 0.1), (0.0, 0.0, 0.0, 1.0), duration=30.0,
                    dt=1e-2)
     out['stable about the minor axis'] = analyse(Trajectory.from_simulation(run))
+    out['wheels exchanging momentum'] = analyse(wheel_trajectory(duration=2.0))
     return out
+
+
+def wheel_trajectory(duration=10.0, inertia_error=1.0):
+    """
+    Simulate a gyrostat with four pyramid wheels under varying motor torques, at 100 Hz.
+
+    ``inertia_error`` scales the wheel inertia the analysis is told (1: the true one).
+    """
+    from rigid_body_dynamics.physics.gyrostat import GyrostatIntegrator, Wheels
+    axes = [c / math.sqrt(3.0) for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
+            for c in g]
+    wheels = Wheels(axes, (0.02,) * 4, coulomb=(1e-4,) * 4, viscous=(1e-6,) * 4)
+    stepper = GyrostatIntegrator((1.0, 2.0, 3.0), wheels, 1e-3, omega0=(0.3, 1.5, -0.4),
+                                 speeds0=(100.0, -50.0, 0.0, 20.0))
+    rows = []
+    for k in range(int(duration * 1000) + 1):
+        if k % 10 == 0:
+            rows.append((k * 1_000_000, stepper.q, stepper.omega, stepper.speeds,
+                         stepper.applied))
+        if k % 100 == 0:      # a new motor command every 0.1 s
+            stepper.command_motors([0.02 * math.sin(0.3 * k / 100 + i) for i in range(4)])
+        stepper.step()
+    told = Wheels(axes, tuple(0.02 * inertia_error for _ in range(4)), coulomb=(1e-4,) * 4,
+                  viscous=(1e-6,) * 4)
+    t, q, w, speeds, motors = (np.array(c) for c in zip(*rows))
+    return Trajectory.from_samples(t, q, w, (1.0, 2.0, 3.0), origin_ns=0, wheels=told,
+                                   wheel_speeds=speeds, motor_torques=motors)
+
+
+def test_a_momentum_exchange_with_wheels_is_conserved_and_a_wrong_wheel_is_not():
+    """Total H constant to round-off; T follows the motor work to the quadrature's error."""
+    found = analyse(wheel_trajectory())
+    c = found.conservation
+    assert c.mode == 'momentum exchange' and c.status == OK, c
+    assert c.momentum_drift < 1e-13 and c.direction_drift < 1e-13
+    assert c.energy_residual < 1e-3                   # trapezoid of a held torque at 100 Hz
+    assert found.precession.status == UNAVAILABLE and 'wheels' in found.precession.message
+    wrong = analyse(wheel_trajectory(inertia_error=1.01)).conservation
+    assert wrong.status in (WARN, ERROR) and 'total H' in wrong.message
 
 
 def test_the_analyzers_diagnostics_read_back_into_the_same_findings():

@@ -2,17 +2,19 @@
 attitude_analyzer: measures what an attitude stream does and checks it against physics.
 
 Works from ``odom`` alone (plus ``applied_torque`` when present), so it can
-audit any attitude source. Inertia comes from the ``inertia`` parameter or else
-from the latched ``inertia`` topic. Only header stamps are used, never arrival
-times: samples are kept sorted by stamp, duplicates dropped; a stamp more than
+audit any attitude source. A body with reaction wheels also needs its wheels
+(the ``wheel_*`` parameters, as the simulator's) and ``wheel_state``: then the
+total H and the energy with the motor work are checked. Inertia comes from the
+``inertia`` parameter or else from the latched ``inertia`` topic. Only header
+stamps are used, never arrival times: samples are kept sorted by stamp, duplicates dropped; a stamp more than
 ``reset_jump`` s before the newest one (a simulator reset or restart) or a gap
 longer than ``max_gap`` s restarts the estimates instead of corrupting them.
 
 Every ``diagnostic_period`` (steady clock) the samples of the last ``window``
 s (by stamp) go to :func:`rigid_body_dynamics.physics.analysis.analyse`, the
 one analysis every door shares, and its findings are formatted by
-:mod:`.analyzer_diagnostics`. Odometry is read by :mod:`rigid_body_dynamics.messages.samples`
-(twist frames honoured; stamps as integer ns). Free-motion drift is measured
+:mod:`.analyzer_diagnostics`. Odometry is read by
+:mod:`rigid_body_dynamics.messages.samples` (twist frames honoured; stamps as integer ns). Free-motion drift is measured
 from the first sample by stamp of the current torque-free segment, kept here
 because the window may have dropped it. Until there is enough data a
 measurement is reported as not available, never as a number.
@@ -30,6 +32,7 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
+from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
@@ -37,9 +40,10 @@ from . import analyzer_diagnostics as diagnostics
 from ..messages import samples
 from ..physics import Inertia
 from ..physics.analysis import analyse, Tolerances, Trajectory
+from ..physics.gyrostat import Wheels
 from ..ros import conversions as conv
 from ..ros.intake import Intake
-from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
+from ..ros.parameters import as_vector, ConfigurationError, number_list, Param, ParameterTable
 from ..ros.runner import run
 from ..ros.throttle import ThrottledWarnings
 
@@ -74,6 +78,19 @@ def _inertia(raw):
         return Inertia.from_tensor(as_vector('inertia', raw, 6))
     except (TypeError, ValueError) as err:
         raise ConfigurationError(f'inertia: {err}') from None
+
+
+def _wheels(values, out):
+    """Cross-check: the wheels (out['wheels'], None without), with the reason if refused."""
+    out['wheels'] = None
+    if not out.get('wheel_axes'):
+        return
+    try:
+        out['wheels'] = Wheels(out['wheel_axes'], out.get('wheel_inertia') or (),
+                               coulomb=out.get('wheel_friction_coulomb'),
+                               viscous=out.get('wheel_friction_viscous'))
+    except ValueError as err:
+        raise ConfigurationError(str(err)) from None
 
 
 #: The parameters of attitude_analyzer (the manual's table is made from this; test_docs checks).
@@ -111,7 +128,21 @@ PARAMETERS = ParameterTable([
     Param('diagnostic_period', 'double', 1.0, '1.0 s',
           'Period of the analysis and of /diagnostics (s, steady clock).', low=0.01,
           high=3600.0, read_only=True),
-])
+    Param('wheel_axes', 'double[]', None, '[] (no wheels)',
+          "The simulated body's reaction wheels, as attitude_simulator's parameter of the "
+          'same name (3 numbers per wheel, body frame): with them and `wheel_state`, '
+          'conservation checks the total H and the energy with the motor work.',
+          read_only=True, convert=number_list('wheel_axes')),
+    Param('wheel_inertia', 'double[]', None, '[]',
+          "Spin-axis moment of each wheel (kg m^2), as attitude_simulator's.", read_only=True,
+          convert=number_list('wheel_inertia')),
+    Param('wheel_friction_coulomb', 'double[]', None, '[] (none)',
+          "Coulomb friction of each wheel (N m), as attitude_simulator's (for the energy "
+          'balance).', read_only=True, convert=number_list('wheel_friction_coulomb')),
+    Param('wheel_friction_viscous', 'double[]', None, '[] (none)',
+          "Viscous friction of each wheel (N m s), as attitude_simulator's.", read_only=True,
+          convert=number_list('wheel_friction_viscous')),
+], cross_checks=(_wheels,))
 
 
 class SampleBuffer:
@@ -129,6 +160,7 @@ class SampleBuffer:
         """Forget every sample."""
         self.t, self.q, self.w = [], [], []
         self.torque_t, self.torque = [], []
+        self.wheel_t, self.wheel = [], []
 
     def add(self, t, q, w, reset_jump, max_gap):
         """Insert one state sample (stamp t, ns) in stamp order; duplicates are dropped."""
@@ -155,6 +187,28 @@ class SampleBuffer:
         self.torque_t.insert(i, t)
         self.torque.insert(i, torque)
 
+    def add_wheels(self, t, speeds, efforts):
+        """Insert one wheel_state sample (stamp t, ns): speeds (rad/s), motor torques (N m)."""
+        i = bisect.bisect_left(self.wheel_t, t)
+        if i < len(self.wheel_t) and self.wheel_t[i] == t:
+            return
+        self.wheel_t.insert(i, t)
+        self.wheel.insert(i, (tuple(speeds), tuple(efforts)))
+
+    def wheel_arrays(self, count):
+        """
+        Return (speeds, motor torques) (N, count) at the state stamps, or None.
+
+        The wheel sample at each state stamp; None unless every state sample has
+        one of ``count`` wheels (the simulator stamps wheel_state with odom's stamp).
+        """
+        found = dict(zip(self.wheel_t, self.wheel))
+        rows = [found.get(t) for t in self.t]
+        if not rows or any(r is None or len(r[0]) != count or len(r[1]) != count
+                           for r in rows):
+            return None
+        return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
+
     def first_from(self, t):
         """Return the earliest state sample (t, q, w) with stamp >= t (ns), or None."""
         i = bisect.bisect_left(self.t, t)
@@ -166,6 +220,8 @@ class SampleBuffer:
         del self.t[:i], self.q[:i], self.w[:i]
         j = bisect.bisect_left(self.torque_t, keep_from)
         del self.torque_t[:j], self.torque[:j]
+        j = bisect.bisect_left(self.wheel_t, keep_from)
+        del self.wheel_t[:j], self.wheel[:j]
 
     def arrays(self):
         """(t ns int64, q, omega, torque at the state stamps); torque 0 where none is known."""
@@ -206,6 +262,7 @@ class AttitudeAnalyzer(Node):
         self._intake = Intake(self)
         self._intake.subscribe(Odometry, 'odom', INPUT_QOS)
         self._intake.subscribe(WrenchStamped, 'applied_torque', INPUT_QOS)
+        self._intake.subscribe(JointState, 'wheel_state', INPUT_QOS)
         self.create_subscription(InertiaStamped, 'inertia', self._on_inertia, LATCHED_QOS)
         self._pub = {name: self.create_publisher(Float64, name, 10) for name in (
             'precession/body_rate', 'precession/lab_rate', 'kinetic_energy',
@@ -287,6 +344,10 @@ class AttitudeAnalyzer(Node):
             for stamp, vec in zip(t.tolist(), tau.tolist()):
                 if all(math.isfinite(c) for c in vec):
                     self._add_torque(stamp, vec)
+        for raw in self._intake.take('wheel_state'):
+            msg = deserialize_message(raw, JointState)
+            self._buffer.add_wheels(samples.stamp_ns(msg.header.stamp), msg.velocity,
+                                    msg.effort)
 
     def _add_odom(self, t, q, w):
         """File one valid state sample (stamp t ns, unit q, body omega)."""
@@ -350,7 +411,8 @@ class AttitudeAnalyzer(Node):
         else:
             t, q, w, tau = buf.arrays()
             origin = int(t[0]) if t.size else 0
-            trajectory = Trajectory.from_samples(t, q, w, self._inertia, tau, origin_ns=origin)
+            trajectory = Trajectory.from_samples(t, q, w, self._inertia, tau, origin_ns=origin,
+                                                 **self._wheel_samples())
             baseline = None
             if self._baseline is not None:
                 b_t, b_q, b_w = self._baseline
@@ -368,6 +430,22 @@ class AttitudeAnalyzer(Node):
         array = DiagnosticArray(status=statuses)
         array.header.stamp = self.get_clock().now().to_msg()
         self._pub_diag.publish(array)
+
+    def _wheel_samples(self):
+        """Trajectory keyword arguments of the wheels (empty without wheels or their samples)."""
+        wheels = self._settings['wheels']
+        if wheels is None:
+            if self._buffer.wheel_t and any(any(s) for s, _u in self._buffer.wheel[-1:]):
+                self._warnings.warn('wheels', 'wheel_state shows spinning wheels but '
+                                    'wheel_axes / wheel_inertia are not set: their momentum '
+                                    'is not counted (set them as on attitude_simulator)')
+            return {}
+        arrays = self._buffer.wheel_arrays(wheels.count)
+        if arrays is None:
+            self._warnings.warn('wheel samples', f'wheel_state does not match the odom stamps '
+                                f'with {wheels.count} wheels yet: analysed without wheels')
+            return {}
+        return {'wheels': wheels, 'wheel_speeds': arrays[0], 'motor_torques': arrays[1]}
 
     def _tolerances(self):
         s = self._settings

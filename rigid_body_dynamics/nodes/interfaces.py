@@ -155,6 +155,9 @@ ANALYZER = Interfaces('attitude_analyzer', [
               '(hidden helper node `_attitude_analyzer_intake`).'),
     Interface('sub', 'inertia', 'geometry_msgs/msg/InertiaStamped',
               'Latched; used unless the `inertia` parameter is set.'),
+    Interface('sub', 'wheel_state', 'sensor_msgs/msg/JointState',
+              "Reaction wheels' speeds and motor torques at the odom stamps; used with the "
+              '`wheel_*` parameters (hidden helper node `_attitude_analyzer_intake`).'),
     Interface('pub', 'precession/body_rate', 'std_msgs/msg/Float64',
               "rad/s: omega about the symmetry axis, body frame (the seed's Omega)."),
     Interface('pub', 'precession/lab_rate', 'std_msgs/msg/Float64',

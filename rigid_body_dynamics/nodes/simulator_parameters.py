@@ -13,7 +13,7 @@ from ..physics import Inertia, INTEGRATORS, presets
 from ..physics.disturbances import GravityGradient
 from ..physics.gyrostat import GyrostatIntegrator, MAX_WHEELS, Wheels
 from ..physics.integrators import REMOVED as REMOVED_INTEGRATORS
-from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
+from ..ros.parameters import as_vector, ConfigurationError, number_list, Param, ParameterTable
 from ..ros.state_publisher import OPTIONAL_TOPICS
 
 
@@ -96,18 +96,6 @@ def _disturbances(values, out):
     out['disturbances'] = Disturbances(
         out['disturbance_torque_body'], out['disturbance_torque_world'],
         out['gravity_gradient_orbit_rate'], out['orbit_normal'], out['orbit_nadir'])
-
-
-def _numbers(name):
-    """Return a converter of a list of any length to a tuple of finite floats."""
-    def convert(value):
-        try:
-            items = list(value)
-        except TypeError:
-            raise ConfigurationError(f'{name} must be a list of numbers, got {value!r}') \
-                from None
-        return as_vector(name, items, len(items))
-    return convert
 
 
 #: The wheel parameters besides wheel_axes, and the Wheels field each fills.
@@ -269,26 +257,27 @@ PARAMETERS = ParameterTable([
           f'Reaction wheels: spin axis of each, 3 numbers per wheel (body frame, unit '
           f'vectors), at most {MAX_WHEELS} wheels; [] = none. With wheels the body is a '
           'gyrostat: the inertia above is the whole body with the wheels locked.',
-          read_only=True, convert=_numbers('wheel_axes')),
+          read_only=True, convert=number_list('wheel_axes')),
     Param('wheel_inertia', 'double[]', None, '[]',
           'Spin-axis moment J of each wheel (kg m^2, > 0).', read_only=True,
-          convert=_numbers('wheel_inertia')),
+          convert=number_list('wheel_inertia')),
     Param('wheel_max_torque', 'double[]', None, '[] (no limit)',
           'Motor torque limit of each wheel (N m; 0 = none): larger commands are clipped and '
-          'counted.', read_only=True, convert=_numbers('wheel_max_torque')),
+          'counted.', read_only=True, convert=number_list('wheel_max_torque')),
     Param('wheel_max_speed', 'double[]', None, '[] (no limit)',
           'Speed limit of each wheel (rad/s relative to the body; 0 = none): at or beyond it '
           'a command that would speed the wheel up is cut to 0 and counted.', read_only=True,
-          convert=_numbers('wheel_max_speed')),
+          convert=number_list('wheel_max_speed')),
     Param('wheel_friction_coulomb', 'double[]', None, '[] (none)',
           'Coulomb friction of each wheel (N m), c tanh(Omega / 0.1 rad/s): smoothed near rest '
-          'so it does not chatter.', read_only=True, convert=_numbers('wheel_friction_coulomb')),
+          'so it does not chatter.', read_only=True,
+          convert=number_list('wheel_friction_coulomb')),
     Param('wheel_friction_viscous', 'double[]', None, '[] (none)',
           'Viscous friction of each wheel (N m s).', read_only=True,
-          convert=_numbers('wheel_friction_viscous')),
+          convert=number_list('wheel_friction_viscous')),
     Param('initial_wheel_speed', 'double[]', None, '[] (all 0)',
           'Wheel speeds (rad/s relative to the body) at start and on ~/reset.', read_only=True,
-          convert=_numbers('initial_wheel_speed')),
+          convert=number_list('initial_wheel_speed')),
 ], cross_checks=(_body, _publish_rate, _imu_rate, _control_steps, _disturbances, _wheels))
 
 

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from . import equations, estimators, theory
+from . import equations, estimators, quaternions, theory
 from .findings import (ConservationFindings, ERROR, Findings, OK, PrecessionFindings, Quantity,
                        StabilityFindings, UNAVAILABLE, WARN)
 from .findings_render import quantity_lines
@@ -44,9 +44,12 @@ class Trajectory:
     ``t_ns`` (N,) int64 ns since ``origin_ns`` (an absolute stamp, e.g. the
     first sample's header stamp, or 0 for simulated time); ``q`` (N, 4) unit
     x-y-z-w body -> world; ``omega`` (N, 3) rad/s body frame; ``torque`` (N, 3)
-    N m body frame, the torque acting at each sample (zeros if none); the
-    ``inertia`` whose body frame these are in. Build with :meth:`from_samples`
-    (sorts, drops duplicates and non-finite samples) or :meth:`from_simulation`.
+    N m body frame, the external torque acting at each sample (zeros if none); the
+    ``inertia`` whose body frame these are in. A body with reaction wheels also has
+    ``wheels`` (a :class:`~.gyrostat.Wheels`, body frame), ``wheel_speeds`` (N, n)
+    rad/s relative to the body and ``motor_torques`` (N, n) N m (the torques applied
+    over the step ending at each sample). Build with :meth:`from_samples` (sorts,
+    drops duplicates and non-finite samples) or :meth:`from_simulation`.
     """
 
     t_ns: np.ndarray
@@ -57,15 +60,20 @@ class Trajectory:
     origin_ns: int = 0
     title: str = ''
     dropped: int = 0
+    wheels: object = None
+    wheel_speeds: object = None
+    motor_torques: object = None
 
     @classmethod
-    def from_samples(cls, t_ns, q, omega, inertia, torque=None, origin_ns=None, title=''):
+    def from_samples(cls, t_ns, q, omega, inertia, torque=None, origin_ns=None, title='',
+                     wheels=None, wheel_speeds=None, motor_torques=None):
         """
         Sort by stamp, keep the first of a duplicated stamp, drop non-finite samples.
 
         ``t_ns`` are absolute integer ns stamps; ``origin_ns`` defaults to the
         earliest. ``q`` is normalised (a zero or non-finite quaternion drops
-        the sample; ``dropped`` counts those).
+        the sample; ``dropped`` counts those). ``wheels``, ``wheel_speeds`` and
+        ``motor_torques``: see the class (one row per sample, or None).
         """
         t_ns = np.asarray(t_ns, dtype=np.int64).reshape(-1)
         q = np.asarray(q, dtype=float).reshape(-1, 4)
@@ -73,19 +81,29 @@ class Trajectory:
         tau = np.zeros_like(w) if torque is None else np.asarray(torque, float).reshape(-1, 3)
         if not (t_ns.size == len(q) == len(w) == len(tau)):
             raise ValueError('t_ns, q, omega and torque must have one row per sample')
+        n = wheels.count if wheels is not None else 0
+        speeds = np.zeros((len(w), n)) if wheel_speeds is None else \
+            np.asarray(wheel_speeds, dtype=float).reshape(len(w), n)
+        motors = np.zeros((len(w), n)) if motor_torques is None else \
+            np.asarray(motor_torques, dtype=float).reshape(len(w), n)
         norm = np.linalg.norm(q, axis=1) if len(q) else np.zeros(0)
         good = (np.isfinite(norm) & (norm > 0.5) & np.all(np.isfinite(w), axis=1)
-                & np.all(np.isfinite(tau), axis=1))
+                & np.all(np.isfinite(tau), axis=1) & np.all(np.isfinite(speeds), axis=1)
+                & np.all(np.isfinite(motors), axis=1))
         dropped = int(np.count_nonzero(~good))
         t_ns, q, w, tau, norm = t_ns[good], q[good], w[good], tau[good], norm[good]
+        speeds, motors = speeds[good], motors[good]
         order = np.argsort(t_ns, kind='stable')
         keep = np.ones(order.size, dtype=bool)
         keep[1:] = np.diff(t_ns[order]) > 0
         idx = order[keep]
         if origin_ns is None:
             origin_ns = int(t_ns[idx[0]]) if idx.size else 0
+        has = wheels is not None and n > 0
         return cls(t_ns[idx] - int(origin_ns), q[idx] / norm[idx, None], w[idx], tau[idx],
-                   as_inertia(inertia), int(origin_ns), title, dropped)
+                   as_inertia(inertia), int(origin_ns), title, dropped,
+                   wheels if has else None, speeds[idx] if has else None,
+                   motors[idx] if has else None)
 
     @classmethod
     def from_seconds(cls, t, q, omega, inertia, torque=None, title=''):
@@ -124,7 +142,9 @@ class Trajectory:
         if end is not None:
             keep &= rel <= end
         return Trajectory(self.t_ns[keep], self.q[keep], self.omega[keep], self.torque[keep],
-                          self.inertia, self.origin_ns, self.title, self.dropped)
+                          self.inertia, self.origin_ns, self.title, self.dropped, self.wheels,
+                          None if self.wheels is None else self.wheel_speeds[keep],
+                          None if self.wheels is None else self.motor_torques[keep])
 
     def principal(self):
         """(moments, q, omega, torque) in the principal frame of the inertia."""
@@ -161,8 +181,18 @@ def analyse(trajectory, baseline=None, tolerances=Tolerances()):
         baseline = (int(b_t),
                     trajectory.inertia.attitude_to_principal(np.asarray(b_q, dtype=float)),
                     trajectory.inertia.to_principal(np.asarray(b_w, dtype=float)))
-    conservation = _conservation(t, q, w, tau, moments, baseline, under_torque, tol)
-    if under_torque:
+    spinning = trajectory.wheels is not None and bool(
+        np.any(trajectory.wheel_speeds != 0.0) or np.any(trajectory.motor_torques != 0.0))
+    if spinning:
+        conservation = _momentum_exchange(trajectory, q, w, under_torque, tol)
+    else:
+        conservation = _conservation(t, q, w, tau, moments, baseline, under_torque, tol)
+    if spinning:
+        why = ("the wheels carry momentum: the gyrostat's precession and stability are not "
+               'analysed yet')
+        precession = PrecessionFindings(UNAVAILABLE, why, UNAVAILABLE)
+        stability = StabilityFindings(UNAVAILABLE, why)
+    elif under_torque:
         why = 'torque applied in the window: the free-motion theory does not apply'
         precession = PrecessionFindings(UNAVAILABLE, why, UNAVAILABLE)
         stability = _stability(t, w, moments, trajectory.inertia, tol, torque_why=why)
@@ -173,6 +203,51 @@ def analyse(trajectory, baseline=None, tolerances=Tolerances()):
                     kinetic_energy=float(equations.kinetic_energy(moments, w[-1])),
                     angular_momentum_norm=float(np.linalg.norm(moments * w[-1])),
                     under_torque=under_torque)
+
+
+def _momentum_exchange(trajectory, q, w, under_torque, tol):
+    """
+    Conservation of a body with spinning wheels: total H constant, T by the motor work.
+
+    With no external torque in the window: the drift of the total H = I omega +
+    sum J Omega g (world frame) from the window's first sample, against the
+    momentum tolerance, and the work-energy residual
+    max |T - T0 - int sum Omega (u - f) dt| / T0 (trapezoid over the samples, u
+    the motor torques, f the wheels' friction), against the balance tolerance.
+    """
+    if under_torque:
+        return ConservationFindings(
+            UNAVAILABLE, 'external torque and spinning wheels in the window: the balance '
+            'with wheels under external torque is not checked yet', UNAVAILABLE)
+    body, wheels = trajectory.inertia, trajectory.wheels
+    moments = np.asarray(body.moments, dtype=float)
+    axes = body.to_principal(np.array(wheels.axes))               # (n, 3) principal frame
+    j = np.array(wheels.inertia)
+    speeds, motors = trajectory.wheel_speeds, trajectory.motor_torques
+    h_body = moments * w + (speeds * j) @ axes                    # principal frame
+    h_world = quaternions.rotate(q, h_body)
+    norm = np.linalg.norm(h_world, axis=1)
+    h0 = h_world[0]
+    momentum = float(np.max(np.abs(norm / norm[0] - 1.0)))
+    direction = float(np.max(np.arctan2(np.linalg.norm(np.cross(h_world, h0), axis=1),
+                                        h_world @ h0)))
+    energy = (0.5 * np.sum(moments * w * w, axis=1) + np.sum(j * speeds * (w @ axes.T), axis=1)
+              + 0.5 * np.sum(j * speeds * speeds, axis=1))
+    friction = np.array([wheels.friction(row) for row in speeds]).reshape(speeds.shape)
+    power = np.sum(speeds * (motors - friction), axis=1)
+    t = trajectory.t
+    work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
+    residual = float(np.max(np.abs(energy - energy[0] - work)) / energy[0]) if energy[0] else \
+        float(np.max(np.abs(energy - energy[0] - work)))
+    ratio_l, ratio_e = max(momentum, direction) / tol.momentum, residual / tol.balance
+    status = level(max(ratio_l, ratio_e))
+    message = 'momentum exchanged, total H conserved' if status == OK else (
+        f'{"total H" if ratio_l >= ratio_e else "energy balance"} off by '
+        f'{max(ratio_l, ratio_e):.3g} x tolerance')
+    return ConservationFindings(status, message, 'momentum exchange', momentum_drift=momentum,
+                                direction_drift=direction, energy_residual=residual,
+                                work=float(work[-1]), energy_tolerance=tol.balance,
+                                momentum_tolerance=tol.momentum)
 
 
 def _conservation(t, q, w, tau, moments, baseline, under_torque, tol):

@@ -44,13 +44,19 @@ CONSERVATION = (
     ('balance laws', 'energy_residual', 'work-energy residual (rel.)'),
     ('balance laws', 'momentum_residual', 'impulse-momentum residual (rel.)'),
     ('balance laws', 'work', 'work over the window (J)'),
+    ('momentum exchange', 'momentum_drift', 'total H drift since window start (rel.)'),
+    ('momentum exchange', 'direction_drift', 'total H direction drift since window start (rad)'),
+    ('momentum exchange', 'energy_residual', 'work-energy residual with motor work (rel.)'),
+    ('momentum exchange', 'work', 'motor work less friction over the window (J)'),
 )
 _MODES = {'free motion': 'free motion',
-          'balance laws': 'balance laws (torque applied in the window)'}
+          'balance laws': 'balance laws (torque applied in the window)',
+          'momentum exchange': 'momentum exchange (reaction wheels)'}
 #: The other keys, for the manual (generated from here; the suite checks that every key
 #: the analyzer writes is listed): (status, key, meaning).
 OTHER_KEYS = (
-    ('conservation', 'mode', '`free motion` or `balance laws (torque applied in the window)`'),
+    ('conservation', 'mode', '`free motion`, `balance laws (torque applied in the window)` or '
+     '`momentum exchange (reaction wheels)`'),
     ('conservation', 'baseline stamp (s)', 'stamp of the drift baseline (free motion)'),
     ('conservation', 'energy tolerance', 'the tolerance the energy was checked against'),
     ('conservation', 'momentum tolerance', 'the tolerance the momentum was checked against'),
@@ -154,6 +160,10 @@ def conservation_line(c):
     if c.mode == 'balance laws':
         return (f'  conservation under torque: {c.message} (work-energy residual '
                 f'{c.energy_residual:.1e}, impulse-momentum {c.momentum_residual:.1e})')
+    if c.mode == 'momentum exchange':
+        return (f'  conservation with wheels: {c.message} (total H drift {c.momentum_drift:.1e}, '
+                f'direction {c.direction_drift:.1e} rad, work-energy residual '
+                f'{c.energy_residual:.1e})')
     return f'  conservation: {c.message}'
 
 
@@ -188,6 +198,11 @@ def table_rows(found):
     elif c.mode == 'balance laws':
         rows += [('work-energy residual (rel.)', f'{c.energy_residual:.2e}', '0'),
                  ('impulse-momentum residual (rel.)', f'{c.momentum_residual:.2e}', '0')]
+    elif c.mode == 'momentum exchange':
+        rows += [('largest total H drift (rel.)', f'{c.momentum_drift:.2e}', '0'),
+                 ('largest total H direction drift (rad)', f'{c.direction_drift:.2e}', '0'),
+                 ('work-energy residual with motor work (rel.)', f'{c.energy_residual:.2e}',
+                  '0')]
 
     def row(section, field, qty):
         measured = text(qty.measured) if qty.measured is not None else \

@@ -61,6 +61,18 @@ def as_vector(name, value, size):
     return tuple(as_float(f'{name}[{i}]', v) for i, v in enumerate(items))
 
 
+def number_list(name):
+    """Return a converter of a list of any length into a tuple of finite floats ('double[]')."""
+    def convert(value):
+        try:
+            items = list(value)
+        except TypeError:
+            raise ConfigurationError(f'{name} must be a list of numbers, got {value!r}') \
+                from None
+        return as_vector(name, items, len(items))
+    return convert
+
+
 def check_change(logger, validate, values):
     """
     Run ``validate(values)`` for an on-set-parameters callback, without side effects.
