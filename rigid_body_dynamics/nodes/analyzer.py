@@ -7,17 +7,19 @@ audit any attitude source. A body with reaction wheels also needs its wheels
 total H and the energy with the motor work are checked. Inertia comes from the
 ``inertia`` parameter or else from the latched ``inertia`` topic. Only header
 stamps are used, never arrival times: samples are kept sorted by stamp,
-duplicates dropped; a stamp more than ``reset_jump`` s before the newest one (a simulator reset or restart) or a gap
-longer than ``max_gap`` s restarts the estimates instead of corrupting them.
+duplicates dropped; a stamp more than ``reset_jump`` s before the newest one (a
+simulator reset or restart) or a gap longer than ``max_gap`` s restarts the
+estimates instead of corrupting them.
 
-Every ``diagnostic_period`` (steady clock) the samples of the last ``window``
-s (by stamp) go to :func:`rigid_body_dynamics.physics.analysis.analyse`, the
-one analysis every door shares, and its findings are formatted by
+Every ``diagnostic_period`` (steady clock) the samples of the last ``window`` s
+(by stamp) go to :func:`rigid_body_dynamics.physics.analysis.analyse`, the one
+analysis every door shares, and its findings are formatted by
 :mod:`.analyzer_diagnostics`. Odometry is read by
 :mod:`rigid_body_dynamics.messages.samples` (twist frames honoured; stamps as
-integer ns). Free-motion drift is measured from the first sample by stamp of the current torque-free segment, kept here
-because the window may have dropped it. Until there is enough data a
-measurement is reported as not available, never as a number.
+integer ns). Free-motion drift is measured from the first sample by stamp of
+the current torque-free segment, kept here because the window may have dropped
+it. Until there is enough data a measurement is reported as not available,
+never as a number.
 """
 
 import bisect
