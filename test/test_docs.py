@@ -122,7 +122,9 @@ def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs
                                                     '-p', 'wheel_axes:=[0.0, 0.0, 1.0]',
                                                     '-p', 'wheel_inertia:=[0.01]']),
                'attitude_analyzer': ('analyzer', []), 'poinsot_visualizer': ('poinsot', []),
-               'attitude_controller': ('controller', [])}
+               'attitude_controller': ('controller', [
+                   '-p', 'actuator:=wheels', '-p', 'wheel_axes:=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, '
+                   '0.0, 0.0, 1.0]', '-p', 'wheel_inertia:=[0.01, 0.01, 0.01]'])}
     for node, (module, args) in modules.items():
         launch(f'rigid_body_dynamics.nodes.{module}', *args, name=node, env=env)
     tables = {'attitude_simulator': simulator.PARAMETERS, 'attitude_analyzer': analyzer.PARAMETERS,

@@ -182,3 +182,94 @@ def test_bad_wheels_are_refused_with_the_reason(kwargs, match):
 def test_wheels_too_heavy_for_the_body_are_refused():
     with pytest.raises(ValueError, match='too heavy'):
         GyrostatIntegrator((1.0, 2.0, 3.0), Wheels(((1.0, 0.0, 0.0),), (1.0,)), 1e-3)
+
+
+# --- Flying the wheels: allocation and momentum dumping ----------------------------------------
+
+def test_the_allocated_motor_torques_give_the_wanted_body_torque():
+    """-G u = tau + omega x h_w to round-off; over the limit all are scaled together."""
+    from rigid_body_dynamics.physics.control import WheelAllocator
+    wheels = Wheels(PYRAMID, (0.02,) * 4, max_torque=(0.05,) * 4, max_speed=(300.0,) * 4)
+    alloc = WheelAllocator(wheels)
+    omega, speeds = (0.01, -0.02, 0.03), (50.0, -20.0, 10.0, 0.0)
+    h = alloc.momentum(speeds)
+    tau = (0.01, -0.02, 0.015)
+    u, dump = alloc.allocate(tau, omega, speeds)
+    reaction = -np.array(PYRAMID).reshape(4, 3).T @ np.array(u)
+    assert np.allclose(reaction, np.array(tau) + np.cross(omega, h), rtol=0, atol=1e-16)
+    assert dump == (0.0, 0.0, 0.0)
+    big, _ = alloc.allocate((1.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0,) * 4)
+    assert max(abs(c) for c in big) == pytest.approx(0.05, rel=1e-15)
+    direction = -np.array(PYRAMID).reshape(4, 3).T @ np.array(big)
+    assert np.allclose(direction / np.linalg.norm(direction), (1.0, 0.0, 0.0), atol=1e-15)
+    # dumping: on at 0.8 of the limit, off under 0.4
+    _, dump = alloc.allocate(tau, omega, (250.0, 0.0, 0.0, 0.0))
+    assert np.allclose(dump, -0.5 * np.array(alloc.momentum((250.0, 0.0, 0.0, 0.0))))
+    assert alloc.allocate(tau, omega, (150.0, 0.0, 0.0, 0.0))[1] != (0.0, 0.0, 0.0)
+    assert alloc.allocate(tau, omega, (100.0, 0.0, 0.0, 0.0))[1] == (0.0, 0.0, 0.0)
+    with pytest.raises(ValueError, match='span three dimensions'):
+        WheelAllocator(Wheels(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (-1.0, 0.0, 0.0)), (0.01,) * 3))
+
+
+def _fly_on_wheels(duration, angle=30.0, wn=0.5, j=0.01, max_speed=600.0,
+                   disturbance=(0.0, 0.0, 0.0)):
+    """
+    Fly the PD (to ``angle`` degrees about x) on four pyramid wheels at 10 ms, offline.
+
+    Returns the per-tick records (t, q, speeds, dump torque), the target and the body.
+    The wheels' 0.2 N m are not reached (the loop stays the linear PD).
+    """
+    from rigid_body_dynamics.physics import quaternions
+    from rigid_body_dynamics.physics.control import QuaternionPD, WheelAllocator
+    moments = (1.0, 1.0, 1.5)
+    wheels = Wheels(PYRAMID, (j,) * 4, max_torque=(0.2,) * 4, max_speed=(max_speed,) * 4)
+    target = quaternions.from_axis_angle(np.array([1.0, 0.0, 0.0]), math.radians(angle))
+    law = QuaternionPD(moments, tuple(target), wn, 0.7)
+    alloc = WheelAllocator(wheels)
+    body = GyrostatIntegrator(moments, wheels, 1e-3)
+    records = []
+    for _ in range(int(round(duration / 0.01))):
+        tau = law(body.q, body.omega)
+        u, dump = alloc.allocate(tau, body.omega, body.speeds)
+        body.command_motors(u)
+        records.append((body.time, body.q, body.speeds, dump))
+        external = tuple(a + b for a, b in zip(dump, disturbance))
+        for _ in range(10):
+            body.step(external)
+    return records, target, body
+
+
+def test_a_slew_on_wheels_settles_as_the_pd_theory_and_keeps_h():
+    """Small-angle PD: settled (2 %) by the theory's time + 10 %; H_w stays 0 (no torque)."""
+    from rigid_body_dynamics.physics import quaternions
+    from rigid_body_dynamics.physics.control import settling_time
+    records, target, body = _fly_on_wheels(20.0)
+    error = np.array([quaternions.angle_between(np.array(q), np.array(target))
+                      for _t, q, _s, _d in records])
+    t = np.array([r[0] for r in records])
+    outside = t[error > 0.02 * error[0]]
+    assert outside.max() < 1.1 * settling_time(0.5, 0.7)
+    assert np.abs(body.angular_momentum_world).max() < 1e-13       # started at rest, no torque
+    # the wheels took the body's momentum and gave it back: rest to rest, wheels to rest
+    assert max(max(abs(s) for s in r[2]) for r in records) > 1.0
+    assert max(abs(s) for s in body.speeds) < 0.05
+
+
+def test_a_disturbance_spins_the_wheels_up_and_dumping_unloads_them():
+    """
+    Hold the attitude against 0.02 N m: the wheels reach 0.8 of 200 rad/s, dump under 0.4.
+
+    The wheels fly the dump torque away from the body, so the attitude stays within
+    0.2 degrees (the PD's steady error 0.02 / (2 I3 wn^2) is 0.1 degree).
+    """
+    from rigid_body_dynamics.physics import quaternions
+    records, target, _ = _fly_on_wheels(25.0, angle=0.0, wn=2.0, j=0.001, max_speed=200.0,
+                                        disturbance=(0.0, 0.0, 0.02))
+    peak = [max(abs(s) for s in r[2]) for r in records]
+    dumping = [any(r[3]) for r in records]
+    first = dumping.index(True)
+    assert peak[first] >= 0.8 * 200.0 and not any(dumping[:first])
+    back = dumping.index(False, first)
+    assert peak[back] <= 0.4 * 200.0 + 1.0                          # unloaded, then stops
+    error = [quaternions.angle_between(np.array(r[1]), np.array(target)) for r in records]
+    assert max(error[100:]) < math.radians(0.2)

@@ -35,6 +35,11 @@ class Lockstep(Pace):
     """
     Lockstep schedule of one body: ``control_every`` steps per tick, ``timeout`` (s).
 
+    ``answer``: the kinds of command a tick waits for, all of them: 'torque' (a
+    torque_cmd stamped at or after the tick) and/or 'wheels' (a valid wheel command
+    that came during the tick's wait: Float64MultiArray has no stamp); default
+    'wheels' for a body with wheels, else 'torque'.
+
     Counters: ``ticks`` answered, ``misses``, ``wait_ns`` (total wall time
     spent waiting for answered ticks after the first) and ``max_wait_ns`` since
     :meth:`take_wait`. Commands come from ``inbox()`` as in :class:`~.pacer.Pace`
@@ -43,9 +48,15 @@ class Lockstep(Pace):
     """
 
     def __init__(self, body, control_every, timeout, clock=time.monotonic_ns,
-                 perf=time.perf_counter, inbox=None, wait=None):
+                 perf=time.perf_counter, inbox=None, wait=None, answer=None):
         super().__init__(body, 0.0, clock=clock, perf=perf, inbox=inbox)
         self.wait = wait if wait is not None else self.mailbox.wait
+        # the kinds of command that answer a tick, all of them: a torque stamped at or after
+        # the tick, a valid wheel command that came during its wait
+        self.answer = frozenset(answer or (('wheels',) if body.wheels is not None
+                                           else ('torque',)))
+        if not self.answer <= {'torque', 'wheels'}:
+            raise ValueError(f'answer must be made of torque and wheels, got {answer!r}')
         self.control_every = int(control_every)
         if self.control_every < 1:
             raise ValueError(f'control_every must be >= 1, got {control_every!r}')
@@ -103,8 +114,10 @@ class Lockstep(Pace):
             now = self.clock()
             self._hold_all()
             cmd = body.command_held
-            answered = self._wheel_answer or (cmd is not None and cmd.stamp_ns is not None
-                                              and cmd.stamp_ns >= body.stamp_now())
+            torque = cmd is not None and cmd.stamp_ns is not None and \
+                cmd.stamp_ns >= body.stamp_now()
+            answered = ('torque' not in self.answer or torque) and \
+                ('wheels' not in self.answer or self._wheel_answer)
             waited = now - self._wait_start
             if answered or (not self._first and self.timeout_ns and waited > self.timeout_ns):
                 self._close_tick(answered, waited)

@@ -16,6 +16,13 @@ saturation at ``max_torque``); ``detumble`` damps the rate only. A
 ``target_orientation`` message (geometry_msgs/QuaternionStamped) overrides
 the parameter. No command goes out before the inertia is known.
 
+``actuator: wheels`` flies the same torque with reaction wheels (the ``wheel_*``
+parameters as the simulator's): :class:`~rigid_body_dynamics.physics.control.WheelAllocator`
+turns it into motor torques on ``wheel_cmd`` from the wheel speeds of the same
+stamp (``wheel_state``), and ``torque_cmd`` (stamped, published first at every
+answer) carries the momentum dump, zero unless a wheel is near its speed limit.
+With the simulator in lockstep set its ``lockstep_answer`` to ``both``.
+
 States are taken by a thread of their own from a wait set (ros/intake.py),
 not by executor callbacks: one DDS hop less of Python overhead per period.
 """
@@ -28,15 +35,20 @@ from geometry_msgs.msg import InertiaStamped, QuaternionStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.serialization import deserialize_message
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
 
-from ..physics.control import QuaternionPD, RateDamper
+from ..physics.control import QuaternionPD, RateDamper, WheelAllocator
+from ..physics.gyrostat import Wheels
 from ..ros import conversions as conv
 from ..ros.intake import Intake
-from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
+from ..ros.parameters import as_vector, ConfigurationError, number_list, Param, ParameterTable
 from ..ros.runner import run
 from ..ros.state_publisher import LATCHED_QOS, STATE_QOS
 
 NODE_NAME = 'attitude_controller'
+#: Longest wait (s) for the wheel_state of an odom's stamp (both come from one tick).
+WHEEL_STATE_WAIT = 1.0
 
 
 def _target(value):
@@ -45,6 +57,20 @@ def _target(value):
     if not norm > 1e-9:
         raise ConfigurationError('target_orientation must not be the zero quaternion')
     return tuple(c / norm for c in q)
+
+
+def _allocator(values, out):
+    """Cross-check: with actuator wheels, a WheelAllocator of valid wheels (out['allocator'])."""
+    out['allocator'] = None
+    if out['actuator'] != 'wheels':
+        return
+    try:
+        wheels = Wheels(out.get('wheel_axes') or (), out.get('wheel_inertia') or (),
+                        max_torque=out.get('wheel_max_torque'),
+                        max_speed=out.get('wheel_max_speed'))
+        out['allocator'] = WheelAllocator(wheels, out['dump_fraction'], out['dump_gain'])
+    except ValueError as err:
+        raise ConfigurationError(f'actuator wheels: {err}') from None
 
 
 #: The parameters of attitude_controller (the manual's table is made from this; test_docs checks).
@@ -66,7 +92,32 @@ PARAMETERS = ParameterTable([
           'Commands per simulated second: a state is answered when its stamp is at least '
           '1 / control_rate after the last answered one; 0 = answer every state.',
           low=0.0, high=1e6),
-])
+    Param('actuator', 'string', 'torque', '`torque`',
+          "torque: the law's torque on torque_cmd; wheels: flown by the reaction wheels "
+          '(wheel_cmd), torque_cmd carrying only the momentum dump.',
+          choices=('torque', 'wheels'), read_only=True),
+    Param('wheel_axes', 'double[]', None, '[]',
+          "The body's reaction wheels, as attitude_simulator's parameter (3 numbers per "
+          'wheel, body frame; at least three wheels spanning space).', read_only=True,
+          convert=number_list('wheel_axes')),
+    Param('wheel_inertia', 'double[]', None, '[]',
+          "Spin-axis moment of each wheel (kg m^2), as attitude_simulator's.",
+          read_only=True, convert=number_list('wheel_inertia')),
+    Param('wheel_max_torque', 'double[]', None, '[] (no limit)',
+          'Motor torque limit of each wheel (N m): the motor torques are scaled down '
+          'together to stay within it.', read_only=True,
+          convert=number_list('wheel_max_torque')),
+    Param('wheel_max_speed', 'double[]', None, '[] (no limit)',
+          'Speed limit of each wheel (rad/s): dumping starts at dump_fraction of it.',
+          read_only=True, convert=number_list('wheel_max_speed')),
+    Param('dump_fraction', 'double', 0.8, '0.8',
+          'Momentum dumping starts when a wheel passes this fraction of its speed limit and '
+          'stops when all are under half of it.', low=0.0, high=1.0, above_low=True,
+          read_only=True),
+    Param('dump_gain', 'double', 0.5, '0.5 1/s',
+          "Dump torque -dump_gain h_w on torque_cmd (h_w the wheels' momentum, body frame).",
+          low=0.0, high=1e6, read_only=True),
+], cross_checks=(_allocator,))
 
 
 class AttitudeController(Node):
@@ -84,11 +135,17 @@ class AttitudeController(Node):
         self._last_ns = None
         self.answered = 0
         self._pub = self.create_publisher(WrenchStamped, 'torque_cmd', STATE_QOS)
+        self._allocator = self._values['allocator']
+        self._wheel_states = {}                # stamp (ns) -> wheel speeds, recent ones
+        if self._allocator is not None:
+            self._pub_wheels = self.create_publisher(Float64MultiArray, 'wheel_cmd', STATE_QOS)
         self.create_subscription(InertiaStamped, 'inertia', self._on_inertia, LATCHED_QOS)
         self.create_subscription(QuaternionStamped, 'target_orientation', self._on_target,
                                  STATE_QOS)
         self._intake = Intake(self)
         self._intake.subscribe(Odometry, 'odom', STATE_QOS)
+        if self._allocator is not None:
+            self._intake.subscribe(JointState, 'wheel_state', STATE_QOS)
         self.add_on_set_parameters_callback(lambda params: PARAMETERS.on_set(self, params))
         self.add_post_set_parameters_callback(self._on_parameters)
         v = self._values
@@ -157,11 +214,40 @@ class AttitudeController(Node):
             if not self._intake.wait('odom', 0.1):
                 continue
             raws = self._intake.take('odom')
-            if raws:
-                self.answer(deserialize_message(raws[-1], Odometry))
+            if not raws:
+                continue
+            odom = deserialize_message(raws[-1], Odometry)
+            if self._allocator is None:
+                self.answer(odom)
+                continue
+            speeds = self._speeds_at(conv.time_ns(odom.header.stamp))
+            if speeds is None:
+                self.get_logger().warning('no wheel_state with the stamp of odom: not answered')
+                continue
+            self.answer(odom, speeds)
 
-    def answer(self, odom):
-        """Answer one state if it is due (the newest pending one): publish torque_cmd."""
+    def _speeds_at(self, stamp_ns):
+        """Return the wheel speeds stamped ``stamp_ns``, waiting for them a little; or None."""
+        waited = 0.0
+        while True:
+            for raw in self._intake.take('wheel_state'):
+                msg = deserialize_message(raw, JointState)
+                self._wheel_states[conv.time_ns(msg.header.stamp)] = tuple(msg.velocity)
+            if len(self._wheel_states) > 1000:            # keep the recent ones
+                for old in sorted(self._wheel_states)[:-100]:
+                    del self._wheel_states[old]
+            if stamp_ns in self._wheel_states or waited >= WHEEL_STATE_WAIT:
+                return self._wheel_states.get(stamp_ns)
+            self._intake.wait('wheel_state', 0.05)
+            waited += 0.05
+
+    def answer(self, odom, speeds=None):
+        """
+        Answer one state if it is due (the newest pending one): publish the command.
+
+        With wheels (``speeds``: their speeds at the state's stamp, rad/s) the dump
+        torque on torque_cmd first, then the motor torques on wheel_cmd.
+        """
         stamp = conv.time_ns(odom.header.stamp)
         with self._lock:
             law = self._law
@@ -174,11 +260,16 @@ class AttitudeController(Node):
             self._next_due_ns = stamp + (round(1e9 / rate) if rate > 0.0 else 1)
         o, w = odom.pose.pose.orientation, odom.twist.twist.angular
         tau = law((o.x, o.y, o.z, o.w), (w.x, w.y, w.z))
+        motors = None
+        if self._allocator is not None:
+            motors, tau = self._allocator.allocate(tau, (w.x, w.y, w.z), speeds)
         cmd = WrenchStamped()
         cmd.header.stamp = odom.header.stamp
         cmd.header.frame_id = odom.child_frame_id
         cmd.wrench.torque.x, cmd.wrench.torque.y, cmd.wrench.torque.z = tau
         self._pub.publish(cmd)
+        if motors is not None:
+            self._pub_wheels.publish(Float64MultiArray(data=list(motors)))
         self.answered += 1
 
     def destroy_node(self):

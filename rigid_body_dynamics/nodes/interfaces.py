@@ -186,8 +186,15 @@ CONTROLLER = Interfaces('attitude_controller', [
               'Latched; no command before it (its diagonal gives the gains).'),
     Interface('sub', 'target_orientation', 'geometry_msgs/msg/QuaternionStamped',
               'Target attitude, body -> world; overrides the parameter.'),
+    Interface('sub', 'wheel_state', 'sensor_msgs/msg/JointState',
+              'The wheel speeds at the stamp of each state answered (hidden helper node '
+              '`_attitude_controller_intake`).', 'if `actuator` is wheels'),
     Interface('pub', 'torque_cmd', 'geometry_msgs/msg/WrenchStamped',
-              'Torque (N m, body frame) stamped with the stamp of the state it answers.'),
+              'Torque (N m, body frame) stamped with the stamp of the state it answers; with '
+              'wheels, the momentum dump (zero unless dumping), published before wheel_cmd.'),
+    Interface('pub', 'wheel_cmd', 'std_msgs/msg/Float64MultiArray',
+              "Motor torques (N m, one per wheel) flying the law's torque.",
+              'if `actuator` is wheels'),
 ])
 
 #: Every node's table, by executable name.

@@ -144,7 +144,8 @@ class AttitudeSimulator(Node):
         if self.lockstep:
             self.pace = Lockstep(self.body, values['control_every'], values['lockstep_timeout'],
                                  inbox=self._inbox,
-                                 wait=lambda timeout: self._intake.wait(self._commands, timeout))
+                                 wait=lambda timeout: self._intake.wait(self._commands, timeout),
+                                 answer=values['answer'])
         else:
             self.pace = Pace(self.body, values['real_time_factor'], on_backlog=self._on_backlog,
                              inbox=self._inbox)

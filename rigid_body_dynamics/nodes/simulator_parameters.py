@@ -129,6 +129,16 @@ def _wheels(values, out):
     out['wheels'], out['wheel_speeds'] = wheels, tuple(speeds)
 
 
+def _lockstep_answer(values, out):
+    """Cross-check: the kinds of command that answer a lockstep tick (out['answer'])."""
+    answer = {'auto': None, 'torque_cmd': ('torque',), 'wheel_cmd': ('wheels',),
+              'both': ('torque', 'wheels')}[out['lockstep_answer']]
+    if answer and 'wheels' in answer and out['wheels'] is None:
+        raise ConfigurationError(f'lockstep_answer {out["lockstep_answer"]} needs wheels '
+                                 '(wheel_axes)')
+    out['answer'] = answer
+
+
 def _publish_rate(values, out):
     """Cross-check: publish_rate <= integration_rate."""
     if out['publish_rate'] > out['integration_rate']:
@@ -231,6 +241,12 @@ PARAMETERS = ParameterTable([
     Param('control_period', 'double', 0.01, '0.01 s',
           'Lockstep control period (s): a whole number of integration steps.',
           low=1e-6, high=1e6, read_only=True),
+    Param('lockstep_answer', 'string', 'auto', '`auto`',
+          'Lockstep: what answers a tick: torque_cmd (stamped at or after the tick), '
+          "wheel_cmd (a valid one during the tick's wait; it has no stamp), or both (a "
+          'controller that flies the wheels and dumps momentum with torque_cmd); auto = '
+          'wheel_cmd with wheels, else torque_cmd.',
+          read_only=True, choices=('auto', 'both', 'torque_cmd', 'wheel_cmd')),
     Param('lockstep_timeout', 'double', 1.0, '1.0 s',
           'Lockstep: after the first command, a tick whose command does not come within this '
           'wall time is a counted, logged miss and the last command is held; 0 = wait for '
@@ -278,7 +294,8 @@ PARAMETERS = ParameterTable([
     Param('initial_wheel_speed', 'double[]', None, '[] (all 0)',
           'Wheel speeds (rad/s relative to the body) at start and on ~/reset.', read_only=True,
           convert=number_list('initial_wheel_speed')),
-], cross_checks=(_body, _publish_rate, _imu_rate, _control_steps, _disturbances, _wheels))
+], cross_checks=(_body, _publish_rate, _imu_rate, _control_steps, _disturbances, _wheels,
+                 _lockstep_answer))
 
 
 def _preset_name(name):

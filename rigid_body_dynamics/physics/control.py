@@ -126,3 +126,69 @@ class QuaternionPD:
         w1, w2, w3 = (float(c) for c in omega)
         return _saturate((-p1 * sign * ex - d1 * w1, -p2 * sign * ey - d2 * w2,
                           -p3 * sign * ez - d3 * w3), self.max_torque)
+
+
+class WheelAllocator:
+    """
+    A body torque flown by reaction wheels, and when to dump their momentum.
+
+    ``wheels``: a :class:`~.gyrostat.Wheels` (axes in the body frame, at least three
+    spanning space). ``allocate(torque, omega, speeds)`` returns (motor torques, dump
+    torque): the motor torques u (N m, one per wheel) whose reaction on the body is
+    the wanted body ``torque`` (N m) with the wheels' gyroscopic coupling cancelled,
+    -G u = torque + omega x h_w, solved with the minimum-norm pseudo-inverse of
+    G = [g_1 .. g_n] and scaled down together (direction kept) to each wheel's
+    ``max_torque``; and the external torque (N m, body frame, for torque_cmd: the
+    stand-in for magnetorquers or thrusters) that unloads the wheels,
+    -``dump_gain`` h_w, from when a wheel passes ``dump_fraction`` of its
+    ``max_speed`` until every wheel is back under half that fraction (zero
+    otherwise, and always without speed limits). h_w = sum J_i Omega_i g_i.
+    """
+
+    def __init__(self, wheels, dump_fraction=0.8, dump_gain=0.5):
+        import numpy as np
+        g = np.array(wheels.axes, dtype=float).T                   # 3 x n
+        if g.shape[1] < 3 or np.linalg.matrix_rank(g) < 3:
+            raise ValueError('the wheel axes must span three dimensions (at least three '
+                             'wheels, not in one plane) for the wheels to fly any torque')
+        self.wheels = wheels
+        self.pinv = tuple(tuple(row) for row in np.linalg.pinv(g).tolist())   # n x 3
+        if not 0.0 < dump_fraction <= 1.0 or not dump_gain >= 0.0:
+            raise ValueError(f'dump_fraction must be in (0, 1] and dump_gain >= 0, got '
+                             f'{dump_fraction!r}, {dump_gain!r}')
+        self.dump_fraction, self.dump_gain = float(dump_fraction), float(dump_gain)
+        self.dumping = False
+
+    def momentum(self, speeds):
+        """Return h_w = sum J_i Omega_i g_i (kg m^2/s, body frame)."""
+        h = [0.0, 0.0, 0.0]
+        for g, j, s in zip(self.wheels.axes, self.wheels.inertia, speeds):
+            for k in range(3):
+                h[k] += j * s * g[k]
+        return tuple(h)
+
+    def allocate(self, torque, omega, speeds):
+        """
+        Return (motor torques, dump torque) for the wanted body ``torque``; see the class.
+
+        While dumping, the wheels also take up the dump torque (they fly ``torque`` -
+        dump), so the body feels ``torque`` alone and the wheels lose the momentum the
+        dump torque takes out.
+        """
+        h = self.momentum(speeds)
+        fractions = [abs(s) / top for s, top in zip(speeds, self.wheels.max_speed) if top > 0.0]
+        if fractions and max(fractions) >= self.dump_fraction:
+            self.dumping = True
+        elif not fractions or max(fractions) <= 0.5 * self.dump_fraction:
+            self.dumping = False
+        dump = tuple(-self.dump_gain * c for c in h) if self.dumping else (0.0, 0.0, 0.0)
+        w1, w2, w3 = omega
+        t1, t2, t3 = (a - b for a, b in zip(torque, dump))
+        want = (-(t1 + w2 * h[2] - w3 * h[1]), -(t2 + w3 * h[0] - w1 * h[2]),
+                -(t3 + w1 * h[1] - w2 * h[0]))
+        u = [row[0] * want[0] + row[1] * want[1] + row[2] * want[2] for row in self.pinv]
+        scale = 1.0
+        for ui, top in zip(u, self.wheels.max_torque):
+            if top > 0.0 and abs(ui) > top:
+                scale = min(scale, top / abs(ui))
+        return tuple(ui * scale for ui in u), dump

@@ -132,6 +132,13 @@ class StatePublisher:
             w_b = inertia.to_body(np.array(w_b))
         stamp = snapshot.stamp_ns
         self._odom.publish(self._odom_bytes.pack(stamp, q_b, w_b))
+        if snapshot.wheels is not None and self._wheel_state is not None:
+            # with odom at every tick (lockstep's too): a controller needs the wheel speeds
+            joints, wheels = self._joints, snapshot.wheels
+            joints.header.stamp = conv.time_msg(stamp)
+            joints.position, joints.velocity = list(wheels.angles), list(wheels.speeds)
+            joints.effort = list(wheels.applied)
+            self._wheel_state.publish(joints)
         if not snapshot.odom_only:   # (lockstep's tick between publish ticks: odom only)
             self._publish_others(snapshot, stamp, q_b, w_b)
         if self._clock is not None:
@@ -159,12 +166,6 @@ class StatePublisher:
             torque = snapshot.torque_principal if inertia.is_principal_frame else \
                 inertia.to_body(np.array(snapshot.torque_principal))
             self._torque.publish(self._torque_bytes.pack(stamp, torque))
-        if wheels is not None and self._wheel_state is not None:
-            joints = self._joints
-            joints.header.stamp = conv.time_msg(stamp)
-            joints.position, joints.velocity = list(wheels.angles), list(wheels.speeds)
-            joints.effort = list(wheels.applied)
-            self._wheel_state.publish(joints)
 
     @property
     def broadcasts_tf(self):
