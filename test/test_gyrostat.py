@@ -220,23 +220,14 @@ def _fly_on_wheels(duration, angle=30.0, wn=0.5, j=0.01, max_speed=600.0,
     The wheels' 0.2 N m are not reached (the loop stays the linear PD).
     """
     from rigid_body_dynamics.physics import quaternions
-    from rigid_body_dynamics.physics.control import QuaternionPD, WheelAllocator
+    from rigid_body_dynamics.physics.control import fly_on_wheels, QuaternionPD, WheelAllocator
     moments = (1.0, 1.0, 1.5)
     wheels = Wheels(PYRAMID, (j,) * 4, max_torque=(0.2,) * 4, max_speed=(max_speed,) * 4)
     target = quaternions.from_axis_angle(np.array([1.0, 0.0, 0.0]), math.radians(angle))
     law = QuaternionPD(moments, tuple(target), wn, 0.7)
-    alloc = WheelAllocator(wheels)
-    body = GyrostatIntegrator(moments, wheels, 1e-3)
-    records = []
-    for _ in range(int(round(duration / 0.01))):
-        tau = law(body.q, body.omega)
-        u, dump = alloc.allocate(tau, body.omega, body.speeds)
-        body.command_motors(u)
-        records.append((body.time, body.q, body.speeds, dump))
-        external = tuple(a + b for a, b in zip(dump, disturbance))
-        for _ in range(10):
-            body.step(external)
-    return records, target, body
+    ticks, body = fly_on_wheels(moments, wheels, law, WheelAllocator(wheels), duration,
+                                disturbance=disturbance)
+    return [(t, q, speeds, dump) for t, q, _w, speeds, _u, dump in ticks], target, body
 
 
 def test_a_slew_on_wheels_settles_as_the_pd_theory_and_keeps_h():

@@ -208,7 +208,7 @@ def test_the_example_controller_flies_the_wheels_in_lockstep_as_offline(launch, 
     """
     import os
     from rigid_body_dynamics.physics import quaternions
-    from rigid_body_dynamics.physics.control import QuaternionPD, WheelAllocator
+    from rigid_body_dynamics.physics.control import fly_on_wheels, QuaternionPD, WheelAllocator
     import yaml
     params = os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples', 'wheels.yaml')
     launch(SIM, '--params-file', params, '-p', 'publish_clock:=true', '-p', 'lockstep:=true',
@@ -231,14 +231,7 @@ def test_the_example_controller_flies_the_wheels_in_lockstep_as_offline(launch, 
     moments = (1.0, 1.0, 1.5)                                 # the default preset
     law = QuaternionPD(moments, tuple(c / math.sqrt(sum(x * x for x in target))
                                       for c in target), 0.5, 0.7)
-    alloc = WheelAllocator(ctl_wheels)
-    body = GyrostatIntegrator(moments, sim_wheels, 1e-3)
-    for _ in range(300):
-        tau = law(body.q, body.omega)
-        u, dump = alloc.allocate(tau, body.omega, body.speeds)
-        body.command_motors(u)
-        for _ in range(10):
-            body.step(dump)
+    _ticks, body = fly_on_wheels(moments, sim_wheels, law, WheelAllocator(ctl_wheels), 3.0)
     _, q, w = odom_arrays([states[3_000_000_000]])
     assert tuple(q[0]) == body.q and tuple(w[0]) == body.omega     # bit for bit
     # a rest-to-rest slew of 30 degrees, wn 0.5 rad/s, zeta 0.7: 47 % of the error left at 3 s

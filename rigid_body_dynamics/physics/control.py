@@ -192,3 +192,33 @@ class WheelAllocator:
             if top > 0.0 and abs(ui) > top:
                 scale = min(scale, top / abs(ui))
         return tuple(ui * scale for ui in u), dump
+
+
+def fly_on_wheels(moments, wheels, law, allocator, duration, control_period=0.01, dt=1e-3,
+                  q0=(0.0, 0.0, 0.0, 1.0), omega0=(0.0, 0.0, 0.0), speeds0=None,
+                  disturbance=(0.0, 0.0, 0.0)):
+    """
+    Close a control loop on reaction wheels offline, as attitude_controller does in lockstep.
+
+    ``moments`` (kg m^2, principal = body frame), ``wheels`` (a
+    :class:`~.gyrostat.Wheels`, the simulated ones), ``law(q, omega)`` -> body torque,
+    ``allocator`` a :class:`WheelAllocator`; every ``control_period`` s (a whole number
+    of steps ``dt``) the law's torque is allocated from the state and held: the motor
+    torques on the wheels, the dump torque plus the constant body ``disturbance`` (N m)
+    as external torque. Returns a list of (t s, q, omega, speeds, motor torques, dump
+    torque) at each control tick, and the final :class:`~.gyrostat.GyrostatIntegrator`.
+    """
+    from .gyrostat import GyrostatIntegrator
+    every = round(control_period / dt)
+    if every < 1 or abs(every * dt - control_period) > 1e-9 * control_period:
+        raise ValueError(f'control_period must be a whole number of steps dt = {dt:g} s')
+    body = GyrostatIntegrator(moments, wheels, dt, q0, omega0, speeds0)
+    records = []
+    for _ in range(int(round(duration / control_period))):
+        u, dump = allocator.allocate(law(body.q, body.omega), body.omega, body.speeds)
+        body.command_motors(u)
+        records.append((body.time, body.q, body.omega, body.speeds, u, dump))
+        external = tuple(a + b for a, b in zip(dump, disturbance))
+        for _ in range(every):
+            body.step(external)
+    return records, body
