@@ -9,8 +9,10 @@ with Ctrl-C's signal: first the default symmetric top (precession rates,
 conservation), then the tennis racket (instability, growth rate, flips),
 then the closed loop: ``attitude_controller`` slewing the default body at
 rest to a target in lockstep, its settling time against the PD theory and
-the pointing error at the end. ``--offline`` measures the same straight from
-the physics layer, without ROS.
+the pointing error at the end; then the same body flown by four reaction
+wheels against a disturbance, the wheels spinning up and unloading their
+momentum. ``--offline`` measures the same straight from the physics layer,
+without ROS.
 """
 
 import argparse
@@ -31,6 +33,18 @@ SLEW = {'target': (math.sin(math.radians(15.0)), 0.0, 0.0, math.cos(math.radians
         'natural_frequency': 2.0, 'damping_ratio': 0.7, 'control_period': 0.01,
         'duration': 10.0}
 CLOSED_LOOP = 'closed_loop'
+#: The wheels scene: 15 degrees about x from rest on four pyramid wheels, wn 1 rad/s, zeta 0.7,
+#: against a constant 0.02 N m about body z that fills the wheels until they dump, 40 s.
+WHEELS = 'wheels'
+_PYRAMID = [c / math.sqrt(3.0) for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
+            for c in g]
+WHEEL_SCENE = {'target': (math.sin(math.radians(7.5)), 0.0, 0.0, math.cos(math.radians(7.5))),
+               'natural_frequency': 1.0, 'damping_ratio': 0.7, 'duration': 40.0,
+               'disturbance': (0.0, 0.0, 0.02),
+               'wheels': {'wheel_axes': _PYRAMID, 'wheel_inertia': [0.01] * 4,
+                          'wheel_max_torque': [0.2] * 4, 'wheel_max_speed': [30.0] * 4,
+                          'wheel_friction_coulomb': [1e-4] * 4,
+                          'wheel_friction_viscous': [1e-6] * 4}}
 
 
 def report(preset, integrator, duration, dt):
@@ -204,6 +218,120 @@ def run_closed_loop():
         f'{", ".join(str(c) for c in codes)})']
 
 
+def _scene_wheels():
+    """Return the wheels of the wheels scene (physics.gyrostat.Wheels)."""
+    from ..physics.gyrostat import Wheels
+    w = WHEEL_SCENE['wheels']
+    return Wheels(w['wheel_axes'], w['wheel_inertia'], w['wheel_max_torque'],
+                  w['wheel_max_speed'], w['wheel_friction_coulomb'], w['wheel_friction_viscous'])
+
+
+def wheel_lines(t, q, speeds, dumping, how):
+    """
+    Lines about the wheels scene: pointing against the PD theory, the wheels' speeds and dumps.
+
+    ``t`` (N,) s, ``q`` (N, 4), ``speeds`` (N, 4) rad/s, ``dumping`` (N,) bool: at the
+    control ticks.
+    """
+    body = presets.get(presets.DEFAULT)
+    scene, target = WHEEL_SCENE, np.array(WHEEL_SCENE['target'])
+    limit = scene['wheels']['wheel_max_speed'][0]
+    error = np.degrees([quaternions.angle_between(a, target) for a in q])
+    held = error[t >= t[-1] / 2.0]
+    # the small-angle PD (gains 2 I wn^2 on the quaternion's vector part) holds a constant
+    # disturbance d about z at theta = d / (I3 wn^2)
+    steady = math.degrees(scene['disturbance'][2] / (body.moments[2]
+                                                     * scene['natural_frequency'] ** 2))
+    fastest = np.max(np.abs(speeds), axis=1)
+    lines = [f'{WHEELS}: a {2 * math.degrees(math.asin(target[0])):g} degree slew about x '
+             f'flown by four pyramid wheels (J {scene["wheels"]["wheel_inertia"][0]:g} kg m^2, '
+             f'{scene["wheels"]["wheel_max_torque"][0]:g} N m, {limit:g} rad/s) against '
+             f'{scene["disturbance"][2]:g} N m about z, {how}',
+             f'  pointing error over the second half: {held.min():.4f} to {held.max():.4f} deg; '
+             f'the PD holds the disturbance at {steady:.4f} deg (small-angle theory)']
+    if np.any(dumping):
+        first = int(np.argmax(dumping))
+        last = first + int(np.argmin(dumping[first:])) if not np.all(dumping[first:]) \
+            else len(t) - 1
+        lines.append(f'  the wheels spun up to {fastest[first]:.1f} rad/s '
+                     f'({100 * fastest[first] / limit:.0f} % of the limit) by t = {t[first]:.2f} '
+                     f's; momentum dumped on torque_cmd until t = {t[last]:.2f} s, down to '
+                     f'{fastest[last]:.1f} rad/s; {fastest[-1]:.1f} rad/s at the end')
+    else:
+        lines.append(f'  the wheels reached {fastest.max():.1f} rad/s: no dump was needed')
+    return lines
+
+
+def wheels_offline():
+    """Run the wheels scene in the physics layer: the controller's law and allocator."""
+    from ..physics.control import fly_on_wheels, WheelAllocator
+    body, scene, wheels = presets.get(presets.DEFAULT), WHEEL_SCENE, _scene_wheels()
+    law = QuaternionPD(body.moments, scene['target'], scene['natural_frequency'],
+                       scene['damping_ratio'])
+    ticks, _ = fly_on_wheels(body.moments, wheels, law, WheelAllocator(wheels),
+                             scene['duration'], q0=body.q0, disturbance=scene['disturbance'])
+    return wheel_lines(np.array([k[0] for k in ticks]), np.array([k[1] for k in ticks]),
+                       np.array([k[3] for k in ticks]), np.array([any(k[5]) for k in ticks]),
+                       'offline')
+
+
+def run_wheels():
+    """Run the wheels scene on the nodes: the simulator in lockstep and attitude_controller."""
+    from geometry_msgs.msg import WrenchStamped
+    from nav_msgs.msg import Odometry
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import JointState
+
+    from ..ros.client import interrupt, RosClient, start_node
+    from ..ros.conversions import time_ns
+    body, scene = presets.get(presets.DEFAULT), WHEEL_SCENE
+    wheel_args = [a for name, value in scene['wheels'].items()
+                  for a in ('-p', f'{name}:={list(value)}')]
+    quiet = ['--log-level', 'warn']
+    sim = start_node('simulator', quiet + wheel_args + [
+        '-p', f'preset:={body.name}', '-p', 'initial_angular_velocity:=[0.0, 0.0, 0.0]',
+        '-p', 'lockstep:=true', '-p', 'lockstep_answer:=both', '-p', 'publish_clock:=true',
+        '-p', f'disturbance_torque_body:={list(scene["disturbance"])}',
+        '-p', 'qos_overrides./odom.publisher.depth:=10000',
+        '-p', 'qos_overrides./wheel_state.publisher.depth:=10000',
+        '-p', 'qos_overrides./applied_torque.publisher.depth:=10000'])
+    states, wheels, torques, ctl = {}, {}, {}, None
+    deep = QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE)
+    client = RosClient('rigid_body_demo')
+    try:
+        node = client.node
+        node.create_subscription(Odometry, 'odom', lambda m: states.setdefault(
+            time_ns(m.header.stamp), (m.pose.pose.orientation.x, m.pose.pose.orientation.y,
+                                      m.pose.pose.orientation.z, m.pose.pose.orientation.w)),
+            deep)
+        node.create_subscription(JointState, 'wheel_state', lambda m: wheels.setdefault(
+            time_ns(m.header.stamp), tuple(m.velocity)), deep)
+        node.create_subscription(WrenchStamped, 'applied_torque', lambda m: torques.setdefault(
+            time_ns(m.header.stamp), m.wrench.torque.z), deep)
+        client.spin_until(lambda: states, 30.0, 'the first state of attitude_simulator')
+        ctl = start_node('controller', quiet + wheel_args + [
+            '-p', 'actuator:=wheels', '-p', f'target_orientation:={list(scene["target"])}',
+            '-p', f'natural_frequency:={scene["natural_frequency"]}',
+            '-p', f'damping_ratio:={scene["damping_ratio"]}'])
+        print(f'{WHEELS}: started attitude_simulator in lockstep with four wheels (pid '
+              f'{sim.pid}) and attitude_controller flying them (pid {ctl.pid}) ...', flush=True)
+        end = int(scene['duration'] * 1e9)
+        client.spin_until(lambda: max(states) >= end and max(torques, default=0) >= end,
+                          180.0, f'{scene["duration"]:g} simulated seconds on wheels')
+    finally:
+        client.close()
+        codes = [interrupt(proc) for proc in (ctl, sim) if proc is not None]
+    ticks = [s for s in sorted(states) if s % 10_000_000 == 0 and s in wheels and s <= end]
+    # applied_torque at the end of a tick (publish ticks are control ticks here): the
+    # disturbance plus the dump held over it
+    dumping = np.array([abs(torques.get(s + 10_000_000, scene['disturbance'][2])
+                            - scene['disturbance'][2]) > 0.0 for s in ticks])
+    return wheel_lines(np.array(ticks) * 1e-9, np.array([states[s] for s in ticks]),
+                       np.array([wheels[s] for s in ticks]), dumping, 'in lockstep') + [
+        f'  stopped attitude_controller and attitude_simulator (exit codes '
+        f'{", ".join(str(c) for c in codes)})']
+
+
 def _is_number(text):
     try:
         float(text)
@@ -228,19 +356,25 @@ def main(argv=None):
     """Console entry point: print theory against simulation (nodes, or --offline)."""
     parser = argparse.ArgumentParser(prog='rigid_body_demo', description=__doc__.splitlines()[1])
     parser.add_argument('--preset', default=None,
-                        help=f'preset name, or {CLOSED_LOOP} (default: a tour of all three)')
+                        help=f'preset name, or {CLOSED_LOOP} or {WHEELS} (default: a tour of '
+                        'all four scenes)')
     parser.add_argument('--integrator', default='exact', choices=sorted(INTEGRATORS))
     parser.add_argument('--duration', type=float, default=None,
                         help='simulated seconds (--offline)')
     parser.add_argument('--dt', type=float, default=1e-3, help='step (s)')
     parser.add_argument('--offline', action='store_true', help='physics only, no ROS nodes')
     args = parser.parse_args(argv)
-    names = [args.preset] if args.preset else ['symmetric_top', 'tennis_racket', CLOSED_LOOP]
+    names = [args.preset] if args.preset else ['symmetric_top', 'tennis_racket', CLOSED_LOOP,
+                                               WHEELS]
     reservation = None if args.offline else _ros_environment()
     try:
         for name in names:
             if name == CLOSED_LOOP:
                 lines = closed_loop_offline() if args.offline else run_closed_loop()
+                print('\n'.join(lines), flush=True)
+                continue
+            if name == WHEELS:
+                lines = wheels_offline() if args.offline else run_wheels()
                 print('\n'.join(lines), flush=True)
                 continue
             body = presets.get(name)
