@@ -50,7 +50,7 @@ def main():
                                            'bodies', 'hosts', 'analyzer-memory', 'bag',
                                            'lockstep', 'bodies-asymmetric', 'latency',
                                            'publish', 'flow-batch', 'command-path',
-                                           'simulate-cost'],
+                                           'simulate-cost', 'wheels'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -112,6 +112,7 @@ SCALE = {
     'flow-batch': ('flow_batch', 'The exact flow one time at a time and over arrays'),
     'command-path': ('command_path', 'The command path in the engine, before and after'),
     'simulate-cost': ('simulate_cost', 'simulate() with a callable torque across the separatrix'),
+    'wheels': ('wheels', 'Reaction wheels beside Basilisk'),
 }
 
 

@@ -208,6 +208,8 @@ def _cases():
                    dt=1e-2)
     out['stable about the minor axis'] = analyse(Trajectory.from_simulation(run))
     out['wheels exchanging momentum'] = analyse(wheel_trajectory(duration=2.0))
+    out['a free gyrostat'] = analyse(_free_gyrostat((1.0, 1.0, 1.5), ((0.0, 0.0, 1.0),), (0.1,),
+                                                    (20.0,), (0.3, 0.0, 2.0), 10.0))
     return out
 
 
@@ -245,7 +247,7 @@ def test_a_momentum_exchange_with_wheels_is_conserved_and_a_wrong_wheel_is_not()
     assert c.mode == 'momentum exchange' and c.status == OK, c
     assert c.momentum_drift < 1e-13 and c.direction_drift < 1e-13
     assert c.energy_residual < 1e-3                   # trapezoid of a held torque at 100 Hz
-    assert found.precession.status == UNAVAILABLE and 'wheels' in found.precession.message
+    assert found.precession.status == UNAVAILABLE and 'motor' in found.precession.message
     wrong = analyse(wheel_trajectory(inertia_error=1.01)).conservation
     assert wrong.status in (WARN, ERROR) and 'total H' in wrong.message
 
@@ -283,3 +285,41 @@ def test_the_analyzers_diagnostics_read_back_into_the_same_findings():
                 'growth rate, measured (1/s)', 'flip interval, measured (s)',
                 'wobble frequency, measured (rad/s)', 'circled axis'):
         assert key in seen, key
+
+
+def _free_gyrostat(moments, axes, j, speeds0, omega0, duration, dt=1e-2):
+    """Sample a torque-free gyrostat at ``dt`` (the motors off): a Trajectory with wheels."""
+    from rigid_body_dynamics.physics.gyrostat import GyrostatIntegrator, Wheels
+    wheels = Wheels(axes, j)
+    body = GyrostatIntegrator(moments, wheels, dt, omega0=omega0, speeds0=speeds0)
+    rows = [(0, body.q, body.omega, body.speeds)]
+    for k in range(1, int(round(duration / dt)) + 1):
+        body.step()
+        rows.append((int(round(k * dt * 1e9)), body.q, body.omega, body.speeds))
+    t, q, w, s = (np.array(c) for c in zip(*rows))
+    return Trajectory.from_samples(t, q, w, moments, origin_ns=0, wheels=wheels,
+                                   wheel_speeds=s, motor_torques=np.zeros_like(s))
+
+
+def test_an_axisymmetric_gyrostat_precesses_at_the_gyrostat_rate():
+    """Rotor on the symmetry axis: body rate ((I3 - I1) omega3 + h) / I1, to 1e-9."""
+    found = analyse(_free_gyrostat((1.0, 1.0, 1.5), ((0.0, 0.0, 1.0),), (0.1,), (20.0,),
+                                   (0.3, 0.0, 2.0), 10.0))
+    p = found.precession
+    assert p.kind == 'gyrostat' and p.status == OK
+    assert p.body_rate.theory == pytest.approx(((1.5 - 1.0) * 2.0 + 2.0) / 1.0, rel=1e-12)
+    assert p.body_rate.relative_error < 1e-9
+    assert found.conservation.mode == 'momentum exchange' and found.conservation.status == OK
+
+
+@pytest.mark.parametrize('h,kind', [(2.0, 'stable'), (0.5, 'unstable')])
+def test_the_gyrostat_theory_judges_a_spin_about_the_intermediate_axis(h, kind):
+    """A rotor of momentum h along axis 2 of (1, 2, 3) spinning at 1 rad/s: h^2 > omega^2."""
+    found = analyse(_free_gyrostat((1.0, 2.0, 3.0), ((0.0, 1.0, 0.0),), (0.05,), (h / 0.05,),
+                                   (1e-6, 1.0, 0.0), 2.0))
+    s = found.stability
+    assert s.axis == 1 and s.kind == kind and 'gyrostat theory' in s.message
+    if kind == 'unstable':
+        assert s.status == WARN and s.growth_rate.theory == pytest.approx(0.5, rel=1e-12)
+    else:
+        assert s.status == OK and s.growth_rate is None

@@ -2,7 +2,8 @@
 The gyrostat (physics/gyrostat.py): a body with reaction wheels, against independent references.
 
 The reference is scipy's DOP853 at rtol 1e-13 on the model written again with numpy
-(np.linalg.solve of the coupled equations), not our scalar code; closed forms for the
+(physics.reference.gyrostat_rhs: np.linalg.solve of the coupled equations), not our
+scalar code; closed forms for the
 axisymmetric precession and the viscous spin-down; the linear stability theory for a
 spin with rotor momentum. Tolerances are stated at each assertion.
 """
@@ -11,9 +12,9 @@ import math
 
 import numpy as np
 import pytest
-from rigid_body_dynamics.physics.gyrostat import (FRICTION_SMOOTHING, GyrostatIntegrator,
-                                                  precession_rate, spin_stability, Wheels)
-from rigid_body_dynamics.physics.quaternions import rotate_components
+from rigid_body_dynamics.physics.gyrostat import (GyrostatIntegrator, precession_rate,
+                                                  spin_stability, Wheels)
+from rigid_body_dynamics.physics.reference import gyrostat_rhs
 from scipy.integrate import solve_ivp
 
 PYRAMID = tuple(tuple(c / math.sqrt(3.0) for c in g) for g in
@@ -23,27 +24,9 @@ PYRAMID = tuple(tuple(c / math.sqrt(3.0) for c in g) for g in
 def reference(moments, wheels, y0, duration, applied=None, torque=(0.0, 0.0, 0.0),
               torque_world=(0.0, 0.0, 0.0)):
     """DOP853 (rtol 1e-13) of the model in matrix form: y = [omega, q, speeds, angles]."""
-    inertia = np.diag(moments)
-    g = np.array(wheels.axes).reshape(-1, 3)
-    j = np.array(wheels.inertia)
-    a = inertia - (g.T * j) @ g
-    coulomb, viscous = np.array(wheels.coulomb), np.array(wheels.viscous)
-    u = np.zeros(len(j)) if applied is None else np.array(applied)
-    n = len(j)
-
-    def rhs(_t, y):
-        w, q, s = y[:3], y[3:7], y[7:7 + n]
-        h = inertia @ w + g.T @ (j * s)
-        tau = np.array(torque) + np.array(rotate_components((-q[0], -q[1], -q[2], q[3]),
-                                                            torque_world))
-        net = u - (coulomb * np.tanh(s / FRICTION_SMOOTHING) + viscous * s)
-        w_dot = np.linalg.solve(a, tau - np.cross(w, h) - g.T @ net)
-        x, yq, z, qw = q
-        q_dot = 0.5 * np.array([qw * w[0] + yq * w[2] - z * w[1], qw * w[1] + z * w[0] - x * w[2],
-                                qw * w[2] + x * w[1] - yq * w[0],
-                                -(x * w[0] + yq * w[1] + z * w[2])])
-        return np.concatenate([w_dot, q_dot, net / j - g @ w_dot, s])
-    sol = solve_ivp(rhs, (0.0, duration), y0, method='DOP853', rtol=1e-13, atol=1e-15)
+    u = np.zeros(wheels.count) if applied is None else applied
+    sol = solve_ivp(gyrostat_rhs(moments, wheels, u, torque, torque_world), (0.0, duration),
+                    y0, method='DOP853', rtol=1e-13, atol=1e-15)
     assert sol.success
     return sol.y[:, -1]
 

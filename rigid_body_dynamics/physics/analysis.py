@@ -188,10 +188,7 @@ def analyse(trajectory, baseline=None, tolerances=Tolerances()):
     else:
         conservation = _conservation(t, q, w, tau, moments, baseline, under_torque, tol)
     if spinning:
-        why = ("the wheels carry momentum: the gyrostat's precession and stability are not "
-               'analysed yet')
-        precession = PrecessionFindings(UNAVAILABLE, why, UNAVAILABLE)
-        stability = StabilityFindings(UNAVAILABLE, why)
+        precession, stability = _gyrostat(trajectory, t, w, under_torque, tol)
     elif under_torque:
         why = 'torque applied in the window: the free-motion theory does not apply'
         precession = PrecessionFindings(UNAVAILABLE, why, UNAVAILABLE)
@@ -203,6 +200,64 @@ def analyse(trajectory, baseline=None, tolerances=Tolerances()):
                     kinetic_energy=float(equations.kinetic_energy(moments, w[-1])),
                     angular_momentum_norm=float(np.linalg.norm(moments * w[-1])),
                     under_torque=under_torque)
+
+
+def _gyrostat(trajectory, t, w, under_torque, tol):
+    """
+    Precession and stability of a torque-free gyrostat (principal-frame omega ``w``).
+
+    Only with no external and no motor torque in the window, and the wheels' momentum
+    h along a principal axis (relative off-axis part under 1e-6): the precession of an
+    axisymmetric body with h on its symmetry axis, lambda = ((I3 - I1) omega3 + h) / I1,
+    measured as :func:`~.estimators.body_precession_rate`; the stability of the spin
+    about the axis the motion stays nearest, with h along it (:func:`~.gyrostat.spin_stability`;
+    the growth rate is the theory's, not measured yet).
+    """
+    from .gyrostat import precession_rate, spin_stability
+    if under_torque or np.any(trajectory.motor_torques != 0.0):
+        why = ("motor or external torque in the window: the torque-free gyrostat's theory "
+               'does not apply')
+        return PrecessionFindings(UNAVAILABLE, why, UNAVAILABLE), StabilityFindings(
+            UNAVAILABLE, why)
+    body, wheels = trajectory.inertia, trajectory.wheels
+    moments = np.asarray(body.moments, dtype=float)
+    axes = body.to_principal(np.array(wheels.axes))
+    h = np.mean((trajectory.wheel_speeds * np.array(wheels.inertia)) @ axes, axis=0)
+    size = float(np.linalg.norm(h))
+    spin_axis = int(np.argmax(np.mean(np.abs(w), axis=0)))
+    symmetric = body.symmetry_axis
+
+    def along(k):
+        return size == 0.0 or math.hypot(*(h[i] for i in range(3) if i != k)) <= 1e-6 * size
+    if symmetric is not None and along(symmetric):
+        theory_rate = precession_rate(moments, float(np.mean(w[:, symmetric])),
+                                      float(h[symmetric]), symmetric)
+        try:
+            measured = estimators.body_precession_rate(t, w, symmetric).rate
+        except ValueError as err:
+            body_rate = unavailable(str(err), theory_rate, 'rad/s')
+        else:
+            body_rate = compare(measured, theory_rate, tol.rate, 'rad/s')
+        precession = PrecessionFindings(
+            body_rate.status, f'gyrostat: omega turns about axis {symmetric + 1} at ((I3 - '
+            f'I1) omega3 + h) / I1, h = {h[symmetric]:.6g} kg m^2/s', 'gyrostat',
+            body_rate=body_rate, symmetry_axis=symmetric)
+    else:
+        precession = PrecessionFindings(
+            UNAVAILABLE, "the wheels' momentum is not along a symmetry axis: no closed form "
+            'for the gyrostat here', UNAVAILABLE)
+    if not along(spin_axis):
+        return precession, StabilityFindings(
+            UNAVAILABLE, f"the wheels' momentum is not along the spin axis {spin_axis + 1}")
+    omega_k = float(np.mean(w[:, spin_axis]))
+    stable, growth = spin_stability(moments, spin_axis, omega_k, float(h[spin_axis]))
+    kind = 'stable' if stable else 'unstable'
+    message = (f'spin about axis {spin_axis + 1} with rotor momentum {h[spin_axis]:.6g} kg m^2/s '
+               f'is {kind} (gyrostat theory)')
+    return precession, StabilityFindings(
+        OK if stable else WARN, message, axis=spin_axis, kind=kind,
+        growth_rate=None if stable else unavailable('not measured for a gyrostat yet', growth,
+                                                    '1/s'))
 
 
 def _momentum_exchange(trajectory, q, w, under_torque, tol):

@@ -60,6 +60,8 @@ OTHER_KEYS = (
     ('conservation', 'baseline stamp (s)', 'stamp of the drift baseline (free motion)'),
     ('conservation', 'energy tolerance', 'the tolerance the energy was checked against'),
     ('conservation', 'momentum tolerance', 'the tolerance the momentum was checked against'),
+    ('precession', 'kind', '`axisymmetric`, `asymmetric`, `gyrostat` (spinning wheels), '
+     '`spherical`, `principal spin` or `unavailable`'),
     ('precession', 'polhode family', 'which axis the polhode circles, or separatrix'),
     ('precession', 'circled axis', 'the principal axis (1-3) the polhode circles'),
     ('precession', 'body cone half-angle (rad)', 'axisymmetric: omega about the symmetry axis'),
@@ -124,7 +126,7 @@ def _shown(found):
     """Return the (section, field, Quantity) entries a rendering shows, in order."""
     p, s = found.precession, found.stability
     out = []
-    if p.kind == 'axisymmetric':
+    if p.kind in ('axisymmetric', 'gyrostat'):
         out += [('precession', 'body_rate', p.body_rate), ('precession', 'lab_rate', p.lab_rate)]
     elif p.kind == 'asymmetric':
         out.append(('precession', 'omega_period', p.omega_period))
@@ -251,7 +253,7 @@ def key_values(found, origin_ns=0):
         cons += [(key, getattr(c, field)) for mode, field, key in CONSERVATION if mode == c.mode]
         cons += [('energy tolerance', c.energy_tolerance),
                  ('momentum tolerance', c.momentum_tolerance)]
-    pre = []
+    pre = [('kind', p.kind)]
     if p.kind == 'asymmetric' or (p.kind != 'axisymmetric' and p.polhode_family):
         pre.append(('polhode family', p.polhode_family))
     if p.kind == 'asymmetric' and p.circled_axis is not None:
@@ -331,8 +333,8 @@ def from_key_values(sections, samples=0, span=math.nan):
         label = _labels(sec, field, probe)[0]
         values = pv if sec == 'precession' else section('stability')[2]
         found[field] = _quantity_from(values, label, UNITS[field])
-    kind = 'axisymmetric' if found['body_rate'] is not None else (
-        'asymmetric' if found['omega_period'] is not None else UNAVAILABLE)
+    kind = pv.get('kind') or ('axisymmetric' if found['body_rate'] is not None else (
+        'asymmetric' if found['omega_period'] is not None else UNAVAILABLE))
     precession = PrecessionFindings(
         p_status, p_message, kind, body_rate=found['body_rate'], lab_rate=found['lab_rate'],
         omega_period=found['omega_period'], mean_precession=found['mean_precession'],

@@ -41,3 +41,72 @@ def zoh_reference(moments, omega0, q0, hold, holds, command, rtol=2.5e-14):
         qs.append(y[3:7].copy())
         ws.append(y[:3].copy())
     return np.array(qs), np.array(ws)
+
+
+def gyrostat_rhs(moments, wheels, motors, torque=(0.0, 0.0, 0.0),
+                 torque_world=(0.0, 0.0, 0.0)):
+    """
+    Return f(t, y) of the gyrostat in matrix form, y = [omega (3), q (4), speeds (n), angles (n)].
+
+    Written apart from :mod:`.gyrostat`'s scalar code (np.linalg.solve of the coupled
+    equations), so the two check each other. ``moments`` principal (kg m^2, the wheels
+    locked in), ``wheels`` a :class:`~.gyrostat.Wheels` with axes in that frame,
+    ``motors`` n motor torques (N m, within their limits), ``torque`` body and
+    ``torque_world`` world external torques (N m), all held.
+    """
+    from .gyrostat import FRICTION_SMOOTHING
+    from .quaternions import rotate_components
+    inertia = np.diag(np.asarray(moments, dtype=float))
+    g = np.array(wheels.axes, dtype=float).reshape(-1, 3)
+    j = np.array(wheels.inertia, dtype=float)
+    a = inertia - (g.T * j) @ g
+    coulomb, viscous = np.array(wheels.coulomb), np.array(wheels.viscous)
+    u = np.asarray(motors, dtype=float).reshape(len(j))
+    n = len(j)
+
+    def rhs(_t, y):
+        w, q, s = y[:3], y[3:7], y[7:7 + n]
+        h = inertia @ w + g.T @ (j * s)
+        tau = np.asarray(torque, dtype=float) + np.array(
+            rotate_components((-q[0], -q[1], -q[2], q[3]), torque_world))
+        net = u - (coulomb * np.tanh(s / FRICTION_SMOOTHING) + viscous * s)
+        w_dot = np.linalg.solve(a, tau - np.cross(w, h) - g.T @ net)
+        x, yq, z, qw = q
+        q_dot = 0.5 * np.array([qw * w[0] + yq * w[2] - z * w[1], qw * w[1] + z * w[0] - x * w[2],
+                                qw * w[2] + x * w[1] - yq * w[0],
+                                -(x * w[0] + yq * w[1] + z * w[2])])
+        return np.concatenate([w_dot, q_dot, net / j - g @ w_dot, s])
+    return rhs
+
+
+def gyrostat_zoh_reference(moments, wheels, q0, omega0, speeds0, hold, holds, command,
+                           rtol=2.5e-14):
+    """
+    Integrate a gyrostat under commands recomputed every ``hold`` s and held in between.
+
+    ``command(k, q, omega, speeds)`` -> (motor torques, body torque) held over
+    [k hold, (k + 1) hold), from the reference's own state; DOP853 restarts at every
+    hold at ``rtol`` (absolute 1e-16, times the size of omega and of the speeds).
+    Returns (q (N, 4), omega (N, 3), speeds (N, n)) at the ``holds`` + 1 boundaries.
+    """
+    n = wheels.count
+    y = np.concatenate([np.asarray(omega0, float), np.asarray(q0, float),
+                        np.asarray(speeds0, float), np.zeros(n)])
+    y[3:7] /= np.linalg.norm(y[3:7])
+    qs, ws, ss = [y[3:7].copy()], [y[:3].copy()], [y[7:7 + n].copy()]
+    for k in range(holds):
+        motors, torque = command(k, tuple(y[3:7]), tuple(y[:3]), tuple(y[7:7 + n]))
+        w_scale = max(float(np.linalg.norm(y[:3])), 1e-9)
+        s_scale = max(float(np.abs(y[7:7 + n]).max(initial=0.0)), 1.0)
+        atol = np.array([1e-16 * w_scale] * 3 + [1e-16] * 4 + [1e-16 * s_scale] * n
+                        + [1e-16 * s_scale * hold * holds] * n)
+        sol = solve_ivp(gyrostat_rhs(moments, wheels, motors, torque), (0.0, hold), y,
+                        method='DOP853', rtol=rtol, atol=atol)
+        if not sol.success:
+            raise RuntimeError(f'reference solver failed at hold {k}: {sol.message}')
+        y = sol.y[:, -1].copy()
+        y[3:7] /= np.linalg.norm(y[3:7])
+        qs.append(y[3:7].copy())
+        ws.append(y[:3].copy())
+        ss.append(y[7:7 + n].copy())
+    return np.array(qs), np.array(ws), np.array(ss)
