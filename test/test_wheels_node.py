@@ -236,3 +236,22 @@ def test_the_example_controller_flies_the_wheels_in_lockstep_as_offline(launch, 
     assert tuple(q[0]) == body.q and tuple(w[0]) == body.omega     # bit for bit
     # a rest-to-rest slew of 30 degrees, wn 0.5 rad/s, zeta 0.7: 47 % of the error left at 3 s
     assert quaternions.angle_between(q[0], np.array(target)) < 0.6 * math.radians(30.0)
+
+
+def test_a_fleet_body_with_wheels_beside_one_without(launch, probe, tmp_path):
+    """attitude_fleet: wheels on body 2 only; its wheel_cmd moves its wheels, not body 1's state."""
+    params = tmp_path / 'fleet.yaml'
+    params.write_text('/body2/attitude_simulator:\n  ros__parameters:\n'
+                      '    wheel_axes: [0.0, 0.0, 1.0]\n    wheel_inertia: [0.01]\n'
+                      '    publish_clock: false\n')
+    launch('rigid_body_dynamics.nodes.fleet', '--params-file', str(params), '--', '--bodies',
+           '2', name='fleet')
+    joints = probe.subscribe(JointState, '/body2/wheel_state')
+    probe.wait_for('/body2/wheel_state', 3)
+    names = {n for n, _t in probe.node.get_topic_names_and_types()}
+    assert '/body2/wheel_cmd' in names and '/body1/wheel_state' not in names
+    pub = probe.publisher(Float64MultiArray, '/body2/wheel_cmd')
+    probe.handshake(pub, Float64MultiArray(data=[0.01]),
+                    lambda: joints and joints[-1].effort[0] == 0.01)
+    probe.spin_for(0.3)
+    assert joints[-1].velocity[0] > 0.0                       # spun up by its motor
