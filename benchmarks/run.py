@@ -50,7 +50,7 @@ def main():
                                            'bodies', 'hosts', 'analyzer-memory', 'bag',
                                            'lockstep', 'bodies-asymmetric', 'latency',
                                            'publish', 'flow-batch', 'command-path',
-                                           'simulate-cost', 'wheels'],
+                                           'simulate-cost', 'wheels', 'wheels-node'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -113,6 +113,7 @@ SCALE = {
     'command-path': ('command_path', 'The command path in the engine, before and after'),
     'simulate-cost': ('simulate_cost', 'simulate() with a callable torque across the separatrix'),
     'wheels': ('wheels', 'Reaction wheels beside Basilisk'),
+    'wheels-node': ('wheels_node', 'attitude_simulator with reaction wheels: CPU'),
 }
 
 
