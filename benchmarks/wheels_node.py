@@ -13,9 +13,8 @@ import os
 import statistics
 
 from diagnostic_msgs.msg import DiagnosticArray
-from std_msgs.msg import Float64MultiArray
-
 from nodes import measure_cpu, Probe, sim
+from std_msgs.msg import Float64MultiArray
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WHEELS = os.path.join(HERE, '..', 'doc', 'examples', 'wheels.yaml')

@@ -150,3 +150,21 @@ def test_interactive_views_draw_this_run_and_the_box_has_its_moments(tmp_path):
     page = report_page.write(str(tmp_path), views)
     assert os.path.getsize(tmp_path / 'plotly.min.js') > 1_000_000
     assert 'src="http' not in page and 'cdn.plot.ly' not in page        # nothing online
+
+
+def test_the_wheels_report_shows_the_momentum_exchange(tmp_path):
+    """--preset wheels: wheel speeds and |H| of body, wheels and total; only the torque moves H."""
+    out = tmp_path / 'wheels'
+    run = report.wheels_run(10.0)
+    figures, _rows = report.make_report(run, str(out))
+    assert {'wheel_speeds', 'momentum_exchange'} <= set(figures)
+    assert 'polhode' not in figures                    # the rigid body's picture does not apply
+    sizes = figures['momentum_exchange'][1]
+    # the total starts at rest and grows by the 0.02 N m disturbance (about body z, tilted
+    # by at most the 15 degree slew): between cos(15 deg) and 1 times 0.02 t
+    total, t = sizes['total H'], run.t
+    assert total[0] == 0.0
+    assert np.all(total[1:] <= 0.02 * t[1:] * (1.0 + 1e-9))
+    assert np.all(total[1:] >= 0.02 * t[1:] * np.cos(np.radians(15.0)) * (1.0 - 1e-9))
+    # the wheels took the body's momentum during the slew
+    assert sizes['wheels sum J Omega g'].max() > 0.1 and (out / 'momentum_exchange.png').exists()

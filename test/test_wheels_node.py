@@ -239,7 +239,7 @@ def test_the_example_controller_flies_the_wheels_in_lockstep_as_offline(launch, 
 
 
 def test_a_fleet_body_with_wheels_beside_one_without(launch, probe, tmp_path):
-    """attitude_fleet: wheels on body 2 only; its wheel_cmd moves its wheels, not body 1's state."""
+    """attitude_fleet: wheels on body 2 only; its wheel_cmd moves its wheels."""
     params = tmp_path / 'fleet.yaml'
     params.write_text('/body2/attitude_simulator:\n  ros__parameters:\n'
                       '    wheel_axes: [0.0, 0.0, 1.0]\n    wheel_inertia: [0.01]\n'

@@ -262,14 +262,26 @@ def wheel_lines(t, q, speeds, dumping, how):
     return lines
 
 
-def wheels_offline():
-    """Run the wheels scene in the physics layer: the controller's law and allocator."""
+def wheel_scene_ticks(duration=None):
+    """
+    Run the wheels scene in the physics layer (the controller's law and allocator).
+
+    Returns :func:`~rigid_body_dynamics.physics.control.fly_on_wheels`' control ticks
+    (t, q, omega, speeds, motor torques, dump torque) and the scene's wheels.
+    """
     from ..physics.control import fly_on_wheels, WheelAllocator
     body, scene, wheels = presets.get(presets.DEFAULT), WHEEL_SCENE, _scene_wheels()
     law = QuaternionPD(body.moments, scene['target'], scene['natural_frequency'],
                        scene['damping_ratio'])
     ticks, _ = fly_on_wheels(body.moments, wheels, law, WheelAllocator(wheels),
-                             scene['duration'], q0=body.q0, disturbance=scene['disturbance'])
+                             duration or scene['duration'], q0=body.q0,
+                             disturbance=scene['disturbance'])
+    return ticks, wheels
+
+
+def wheels_offline():
+    """Run the wheels scene in the physics layer; the printable lines."""
+    ticks, _ = wheel_scene_ticks()
     return wheel_lines(np.array([k[0] for k in ticks]), np.array([k[1] for k in ticks]),
                        np.array([k[3] for k in ticks]), np.array([any(k[5]) for k in ticks]),
                        'offline')

@@ -37,6 +37,54 @@ from ..physics.findings_render import table_rows
 from ..physics.sensors import allan_deviation, GyroErrors, GyroModel
 
 
+def wheels_run(duration=None):
+    """
+    Run the demo's wheels scene offline: a Trajectory with its wheels (at the control ticks).
+
+    The external torque of each tick (the scene's disturbance plus the dump) is its torque.
+    """
+    from .demo import WHEEL_SCENE, wheel_scene_ticks
+    ticks, wheels = wheel_scene_ticks(duration)
+    disturbance = np.array(WHEEL_SCENE['disturbance'])
+    t, q, w, speeds, motors, dump = (np.array(c) for c in zip(*ticks))
+    return Trajectory.from_samples(np.round(t * 1e9).astype(np.int64), q, w,
+                                   presets.get(presets.DEFAULT).moments, dump + disturbance,
+                                   origin_ns=0, title='wheels scene (offline)', wheels=wheels,
+                                   wheel_speeds=speeds, motor_torques=motors)
+
+
+def wheels_figures(run, out_dir):
+    """
+    Figures of a run with wheels: their speeds, and the momentum exchange (world frame).
+
+    |H| of the body (I omega), of the wheels (sum J Omega g) and of the whole
+    (their sum, which only external torque changes). Returns {name: (png, curves)}.
+    """
+    inertia, wheels = run.inertia, run.wheels
+    t = run.t
+    fig, ax = _figure('Reaction wheel speeds (relative to the body)', 'time (s)',
+                      'Omega (rad/s)')
+    curves = {}
+    for i in range(wheels.count):
+        ax.plot(t, run.wheel_speeds[:, i], label=f'wheel_{i}')
+        curves[f'wheel_{i}'] = run.wheel_speeds[:, i]
+    ax.legend(loc='best')
+    out = {'wheel_speeds': (_save(fig, out_dir, 'wheel_speeds.png'), curves)}
+    body_h = run.omega @ inertia.tensor.T
+    wheel_h = (run.wheel_speeds * np.array(wheels.inertia)) @ np.array(wheels.axes)
+    world = {'body I omega': quaternions.rotate(run.q, body_h),
+             'wheels sum J Omega g': quaternions.rotate(run.q, wheel_h)}
+    world['total H'] = world['body I omega'] + world['wheels sum J Omega g']
+    fig, ax = _figure('Momentum exchange: body, wheels and total (world frame)', 'time (s)',
+                      '|H| (kg m^2/s)')
+    sizes = {label: np.linalg.norm(h, axis=1) for label, h in world.items()}
+    for label, size in sizes.items():
+        ax.plot(t, size, label=label)
+    ax.legend(loc='best')
+    out['momentum_exchange'] = (_save(fig, out_dir, 'momentum_exchange.png'), sizes)
+    return out
+
+
 def offline_run(preset, integrator, duration, dt, progress=None, gyro=None):
     """
     Simulate a preset into a Trajectory; ``progress(fraction)`` is called as it goes.
@@ -146,6 +194,44 @@ def momentum_sphere_figure(moments, l_body, out_dir):
     return _save(fig, out_dir, 'momentum_sphere.png'), curves
 
 
+def _rigid_body_figures(moments, t, q, w, out_dir):
+    """Draw the rigid body's figures: polhode, herpolhode, momentum sphere, drift."""
+    figures = {}
+    geometry = poinsot.construction(moments, q[0], w[0])
+    fig, ax = _figure('Polhode: omega on the inertia ellipsoid omega.I.omega = 2T (body frame)',
+                      'omega_1 (rad/s)', 'omega_2 (rad/s)', projection='3d')
+    ax.plot_wireframe(*poinsot.ellipsoid_surface(geometry.semi_axes, 40), color='0.8',
+                      linewidth=0.5)
+    ax.plot(w[:, 0], w[:, 1], w[:, 2], color='tab:red', label='polhode')
+    ax.set_zlabel('omega_3 (rad/s)')
+    ax.legend(loc='upper left')
+    figures['polhode'] = (_save(fig, out_dir, 'polhode.png'), {'polhode': w})
+
+    w_world = quaternions.rotate(q, w)
+    e1, e2, _ = estimators.basis_perpendicular(geometry.normal)
+    plane = np.stack([w_world @ e1, w_world @ e2], axis=1)
+    fig, ax = _figure('Herpolhode: omega in the invariant plane (world frame, normal L)',
+                      'along e_u (rad/s)', 'along e_v (rad/s)')
+    ax.plot(plane[:, 0], plane[:, 1], color='tab:purple', label='herpolhode')
+    ax.plot([0.0], [0.0], 'k+', label='foot of L on the plane')
+    ax.set_aspect('equal', adjustable='datalim')
+    ax.legend(loc='best')
+    figures['herpolhode'] = (_save(fig, out_dir, 'herpolhode.png'), {'herpolhode': plane})
+
+    figures['momentum_sphere'] = momentum_sphere_figure(moments, moments * w, out_dir)
+
+    floor = np.finfo(float).eps
+    drift = dict(zip(('|T/T0 - 1|', '||L|/|L0| - 1|', 'angle(L, L0) (rad)'),
+                     estimators.drift_series(moments, q, w, q[0], w[0])))
+    fig, ax = _figure('Conservation: drift from the first sample (log scale; floor = eps)',
+                      'time (s)', 'relative drift')
+    for label, values in drift.items():
+        ax.semilogy(t, np.maximum(values, floor), label=label)
+    ax.legend(loc='best')
+    figures['conservation'] = (_save(fig, out_dir, 'conservation.png'), drift)
+    return figures
+
+
 def make_report(run, out_dir, gyro=None):
     """
     Write the figures and index.html for ``run`` into ``out_dir``.
@@ -170,39 +256,11 @@ def make_report(run, out_dir, gyro=None):
     ax.legend(loc='best')
     figures['omega'] = (_save(fig, out_dir, 'omega.png'), curves)
 
-    geometry = poinsot.construction(moments, q[0], w[0])
-    fig, ax = _figure('Polhode: omega on the inertia ellipsoid omega.I.omega = 2T (body frame)',
-                      'omega_1 (rad/s)', 'omega_2 (rad/s)', projection='3d')
-    ax.plot_wireframe(*poinsot.ellipsoid_surface(geometry.semi_axes, 40), color='0.8',
-                      linewidth=0.5)
-    ax.plot(w[:, 0], w[:, 1], w[:, 2], color='tab:red', label='polhode')
-    ax.set_zlabel('omega_3 (rad/s)')
-    ax.legend(loc='upper left')
-    figures['polhode'] = (_save(fig, out_dir, 'polhode.png'), {'polhode': w})
-
-    w_world = quaternions.rotate(q, w)
-    e1, e2, _ = estimators.basis_perpendicular(geometry.normal)
-    plane = np.stack([w_world @ e1, w_world @ e2], axis=1)
-    fig, ax = _figure('Herpolhode: omega in the invariant plane (world frame, normal L)',
-                      'along e_u (rad/s)', 'along e_v (rad/s)')
-    ax.plot(plane[:, 0], plane[:, 1], color='tab:purple', label='herpolhode')
-    ax.plot([0.0], [0.0], 'k+', label='foot of L on the plane')
-    ax.set_aspect('equal', adjustable='datalim')
-    ax.legend(loc='best')
-    figures['herpolhode'] = (_save(fig, out_dir, 'herpolhode.png'), {'herpolhode': plane})
-
-    figures['momentum_sphere'] = momentum_sphere_figure(moments, moments * w, out_dir)
-
     found = analyse(run)
-    floor = np.finfo(float).eps
-    drift = dict(zip(('|T/T0 - 1|', '||L|/|L0| - 1|', 'angle(L, L0) (rad)'),
-                     estimators.drift_series(moments, q, w, q[0], w[0])))
-    fig, ax = _figure('Conservation: drift from the first sample (log scale; floor = eps)',
-                      'time (s)', 'relative drift')
-    for label, values in drift.items():
-        ax.semilogy(t, np.maximum(values, floor), label=label)
-    ax.legend(loc='best')
-    figures['conservation'] = (_save(fig, out_dir, 'conservation.png'), drift)
+    if run.wheels is None:
+        figures.update(_rigid_body_figures(moments, t, q, w, out_dir))
+    else:                        # the Poinsot picture is the rigid body's: the wheels' instead
+        figures.update(wheels_figures(run, out_dir))
 
     pre, stab = found.precession, found.stability
     if pre.kind == 'axisymmetric':
@@ -235,7 +293,8 @@ def make_report(run, out_dir, gyro=None):
     if gyro is not None:
         figures['allan'] = allan_figure(*gyro, out_dir)
     rows = table_rows(found)
-    interactive = report_page.write(out_dir, report_page.views(moments, t, q, w))
+    interactive = report_page.write(out_dir, report_page.views(moments, t, q, w)) \
+        if run.wheels is None else ''    # (the interactive page shows the Poinsot picture)
     _write_html(run, out_dir, figures, rows, interactive)
     return figures, rows
 
@@ -274,7 +333,8 @@ def main(argv=None):
     parser = argparse.ArgumentParser(prog='rigid_body_report',
                                      description='Figures and an HTML page about a run.')
     source = parser.add_mutually_exclusive_group()
-    source.add_argument('--preset', help='simulate this preset offline (default symmetric_top)')
+    source.add_argument('--preset', help='simulate this preset offline (default symmetric_top), '
+                        "or wheels: the demo's scene on four reaction wheels")
     source.add_argument('--bag', help='a rosbag2 folder or a .mcap / .db3 file to report on')
     source.add_argument('--record', metavar='DIR', help='record the running nodes into a new '
                         'rosbag2 bag (MCAP) in this folder, then report on it')
@@ -301,6 +361,8 @@ def main(argv=None):
             run = read_trajectory(args.bag)[0]
         elif args.record:
             run = recorder.record(args.record, args.duration or 20.0)
+        elif args.preset == 'wheels':
+            run = wheels_run(args.duration)
         else:
             name = args.preset or presets.DEFAULT
             body = presets.get(name)
