@@ -265,8 +265,10 @@ def _momentum_exchange(trajectory, q, w, under_torque, tol):
     Conservation of a body with spinning wheels: total H constant, T by the motor work.
 
     With no external torque in the window: the drift of the total H = I omega +
-    sum J Omega g (world frame) from the window's first sample, against the
-    momentum tolerance, and the work-energy residual
+    sum J Omega g (world frame) from the window's first sample, max |H - H0| over
+    the largest of |H0|, |I omega| and |h_w| in the window (a body at rest with its
+    wheels has H = 0), and the angle of H from H0 (0 when H0 is 0), against the
+    momentum tolerance; and the work-energy residual
     max |T - T0 - int sum Omega (u - f) dt| / T0 (trapezoid over the samples, u
     the motor torques, f the wheels' friction), against the balance tolerance.
     """
@@ -281,11 +283,15 @@ def _momentum_exchange(trajectory, q, w, under_torque, tol):
     speeds, motors = trajectory.wheel_speeds, trajectory.motor_torques
     h_body = moments * w + (speeds * j) @ axes                    # principal frame
     h_world = quaternions.rotate(q, h_body)
-    norm = np.linalg.norm(h_world, axis=1)
     h0 = h_world[0]
-    momentum = float(np.max(np.abs(norm / norm[0] - 1.0)))
+    # on the scale of the momentum in play: a body at rest with its wheels has H = 0
+    scale = max(float(np.linalg.norm(h0)),
+                float(np.max(np.linalg.norm(moments * w, axis=1))),
+                float(np.max(np.linalg.norm((speeds * j) @ axes, axis=1))))
+    momentum = float(np.max(np.linalg.norm(h_world - h0, axis=1)) / scale) if scale else 0.0
     direction = float(np.max(np.arctan2(np.linalg.norm(np.cross(h_world, h0), axis=1),
-                                        h_world @ h0)))
+                                        h_world @ h0))) \
+        if np.linalg.norm(h0) > 1e-9 * scale else 0.0
     energy = (0.5 * np.sum(moments * w * w, axis=1) + np.sum(j * speeds * (w @ axes.T), axis=1)
               + 0.5 * np.sum(j * speeds * speeds, axis=1))
     friction = np.array([wheels.friction(row) for row in speeds]).reshape(speeds.shape)
