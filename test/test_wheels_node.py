@@ -260,8 +260,10 @@ def test_a_fleet_body_with_wheels_beside_one_without(launch, probe, tmp_path):
 def test_done_when_four_wheels_from_yaml_flown_in_lockstep_and_the_analyzer_says_conserved(
         launch, probe):
     """
-    The issue's "done when": wheels.yaml for the three nodes, the example controller on the
-    wheels in lockstep, and attitude_analyzer calling the momentum exchange conserved.
+    Run the issue's "done when": four wheels in a YAML file, flown in lockstep, judged.
+
+    wheels.yaml for the three nodes, the example controller on the wheels in lockstep,
+    and attitude_analyzer calling the momentum exchange conserved.
     """
     import os
     params = os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples', 'wheels.yaml')
