@@ -59,3 +59,13 @@ def table(header, rows):
     out = ['| ' + ' | '.join(header) + ' |', '|' + '---|' * len(header)]
     out += ['| ' + ' | '.join(str(c) for c in row) + ' |' for row in rows]
     return '\n'.join(out)
+
+
+def best_of(run, repeats):
+    """Run ``run()`` ``repeats`` times; return the result of least cost (its item 0)."""
+    best = None
+    for _ in range(repeats):
+        result = run()
+        if best is None or result[0] < best[0]:
+            best = result
+    return best

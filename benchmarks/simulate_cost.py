@@ -23,7 +23,7 @@ import subprocess
 import sys
 import time
 
-from common import fmt
+from common import best_of, fmt
 import numpy as np
 from rigid_body_dynamics.physics import Inertia, quaternions, simulate
 from rigid_body_dynamics.physics.reference import zoh_reference
@@ -61,7 +61,7 @@ def _torques(tau):
 def rows():
     """Return (unit s per simulated s, [(body, torque, error, cost s per s)]) of this tree."""
     torque.CASES['T3 across the separatrix'] = (MOMENTS, OMEGA0, lambda k, q, w: TAU)
-    unit = torque._best(lambda: torque.plain_rk4('T3 across the separatrix'), REPEATS)[0]
+    unit = best_of(lambda: torque.plain_rk4('T3 across the separatrix'), REPEATS)[0]
     holds = int(round(DURATION / DT))
     q_ref, _ = zoh_reference(MOMENTS, OMEGA0, (0.0, 0.0, 0.0, 1.0), DT, holds,
                              lambda k, q, w: TAU)

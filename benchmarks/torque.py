@@ -30,7 +30,7 @@ Basilisk RKF78 and RK4 (an ``ExtForceTorque`` effector on the hub, its
 import math
 import time
 
-from common import fmt
+from common import best_of, fmt
 import numpy as np
 from peers import basilisk_body, mujoco_body
 from rigid_body_dynamics.physics import make_integrator, quaternions, simulate
@@ -204,16 +204,6 @@ def run_basilisk(case, dt, integrator='svIntegratorRKF78'):
     return (time.perf_counter() - start) / DURATION, qs, ws
 
 
-def _best(run, repeats):
-    """Run ``run()`` ``repeats`` times; the least cost (a busy moment only adds) and its result."""
-    best = None
-    for _ in range(repeats):
-        result = run()
-        if best is None or result[0] < best[0]:
-            best = result
-    return best
-
-
 def measure(peers=False, repeats=5, progress=print):
     """
     Measure both cases; returns {case: rows}.
@@ -225,7 +215,7 @@ def measure(peers=False, repeats=5, progress=print):
     for case in CASES:
         progress(f'torque {case}: reference ...')
         ref = reference(case)
-        unit, q, w = _best(lambda: plain_rk4(case), repeats)
+        unit, q, w = best_of(lambda: plain_rk4(case), repeats)
         rows = []
 
         def add(label, dt, cost, q, w, balance=None):
@@ -238,9 +228,9 @@ def measure(peers=False, repeats=5, progress=print):
         for name in ('exact', 'rk4'):
             for dt in DTS:
                 progress(f'torque {case}: {name} at {dt * 1e3:g} ms')
-                add(f'ours `{name}`', dt, *_best(lambda: run_ours(name, case, dt), repeats))
+                add(f'ours `{name}`', dt, *best_of(lambda: run_ours(name, case, dt), repeats))
         add('ours `exact` through simulate(callable torque)', 1e-2,
-            *_best(lambda: run_simulate(case), repeats))
+            *best_of(lambda: run_simulate(case), repeats))
         if peers:
             for label, run in (('MuJoCo 4.0.0 RK4', run_mujoco),
                                ('Basilisk 2.12.1 RKF78', run_basilisk),
@@ -249,7 +239,7 @@ def measure(peers=False, repeats=5, progress=print):
                 for dt in DTS:
                     progress(f'torque {case}: {label} at {dt * 1e3:g} ms')
                     try:
-                        add(label, dt, *_best(lambda: run(case, dt), min(repeats, 2)))
+                        add(label, dt, *best_of(lambda: run(case, dt), min(repeats, 2)))
                     except ImportError as err:
                         rows.append([label, f'{dt * 1e3:g}', f'not installed ({err.name})',
                                      '', '', '', ''])

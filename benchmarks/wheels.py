@@ -28,7 +28,7 @@ written to the effector's command message before each hold.
 import math
 import time
 
-from common import fmt
+from common import best_of, fmt
 import numpy as np
 from rigid_body_dynamics.physics import quaternions
 from rigid_body_dynamics.physics.control import QuaternionPD, WheelAllocator
@@ -153,15 +153,6 @@ def _errors(ref, qs, ws, ss):
     return attitude, omega, speeds
 
 
-def _best(run):
-    best = None
-    for _ in range(REPEATS):
-        result = run()
-        if best is None or result[0] < best[0]:
-            best = result
-    return best
-
-
 def measure(progress=print):
     """Return RESULTS.md lines: one table per case, ours and Basilisk's."""
     lines = []
@@ -180,7 +171,7 @@ def measure(progress=print):
         for label, dt, run in runs:
             progress(f'wheels {case}: {label} at {dt * 1e3:g} ms')
             try:
-                cost, qs, ws, ss = _best(run)
+                cost, qs, ws, ss = best_of(run, REPEATS)
             except ImportError as err:
                 rows.append(f'| {label} | {dt * 1e3:g} | not installed ({err.name}) | | | |')
                 continue
