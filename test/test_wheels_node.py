@@ -119,13 +119,14 @@ def test_lockstep_with_wheels_is_the_offline_gyrostat_bit_for_bit(launch, probe)
             pub.publish(Float64MultiArray(data=motors(t)))
     probe.node.create_subscription(Odometry, 'odom', on_odom, 100)
     probe.spin_until(lambda: max(states, default=-1) >= 300_000_000, 60.0, '0.3 s in lockstep')
+    check = max(t for t in states if t % 10_000_000 == 0 and 200_000_000 <= t <= 300_000_000)
     ref = GyrostatIntegrator((1.0, 2.0, 3.0), _wheels(), 1e-3, omega0=(0.3, 1.5, -0.4),
                              speeds0=(100.0, -50.0, 0.0, 20.0))
-    for k in range(30):
+    for k in range(check // 10_000_000):
         ref.command_motors(motors(k * 10_000_000))
         for _ in range(10):
             ref.step()
-    _, q, w = odom_arrays([states[300_000_000]])
+    _, q, w = odom_arrays([states[check]])
     assert tuple(q[0]) == ref.q and tuple(w[0]) == ref.omega     # bit for bit
 
 
@@ -221,7 +222,9 @@ def test_the_example_controller_flies_the_wheels_in_lockstep_as_offline(launch, 
     states = {}
     probe.node.create_subscription(Odometry, 'odom',
                                    lambda m: states.setdefault(time_ns(m.header.stamp), m), 100)
-    probe.spin_until(lambda: 3_000_000_000 in states, 120.0, '3 s in lockstep')
+    # (the probe may miss a state under load: a reader does not hold the simulator back)
+    probe.spin_until(lambda: max(states, default=-1) >= 3_000_000_000, 120.0, '3 s in lockstep')
+    check = max(t for t in states if t % 10_000_000 == 0 and 2_000_000_000 <= t <= 3_000_000_000)
     with open(params) as f:
         p = yaml.safe_load(f)['/**']['ros__parameters']
     axes = p['wheel_axes']
@@ -231,11 +234,12 @@ def test_the_example_controller_flies_the_wheels_in_lockstep_as_offline(launch, 
     moments = (1.0, 1.0, 1.5)                                 # the default preset
     law = QuaternionPD(moments, tuple(c / math.sqrt(sum(x * x for x in target))
                                       for c in target), 0.5, 0.7)
-    _ticks, body = fly_on_wheels(moments, sim_wheels, law, WheelAllocator(ctl_wheels), 3.0)
-    _, q, w = odom_arrays([states[3_000_000_000]])
+    _ticks, body = fly_on_wheels(moments, sim_wheels, law, WheelAllocator(ctl_wheels),
+                                 check * 1e-9)
+    _, q, w = odom_arrays([states[check]])
     assert tuple(q[0]) == body.q and tuple(w[0]) == body.omega     # bit for bit
     # a rest-to-rest slew of 30 degrees, wn 0.5 rad/s, zeta 0.7: 47 % of the error left at 3 s
-    assert quaternions.angle_between(q[0], np.array(target)) < 0.6 * math.radians(30.0)
+    assert quaternions.angle_between(q[0], np.array(target)) < 0.75 * math.radians(30.0)
 
 
 def test_a_fleet_body_with_wheels_beside_one_without(launch, probe, tmp_path):
