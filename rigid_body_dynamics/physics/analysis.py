@@ -269,8 +269,9 @@ def _momentum_exchange(trajectory, q, w, under_torque, tol):
     the largest of |H0|, |I omega| and |h_w| in the window (a body at rest with its
     wheels has H = 0), and the angle of H from H0 (0 when H0 is 0), against the
     momentum tolerance; and the work-energy residual
-    max |T - T0 - int sum Omega (u - f) dt| / T0 (trapezoid over the samples, u
-    the motor torques, f the wheels' friction), against the balance tolerance.
+    max |T - T0 - int sum Omega (u - f) dt| over the largest T or |work| in the
+    window (trapezoid over the samples, u the motor torques, f the wheels'
+    friction), against the balance tolerance.
     """
     if under_torque:
         return ConservationFindings(
@@ -298,8 +299,9 @@ def _momentum_exchange(trajectory, q, w, under_torque, tol):
     power = np.sum(speeds * (motors - friction), axis=1)
     t = trajectory.t
     work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
-    residual = float(np.max(np.abs(energy - energy[0] - work)) / energy[0]) if energy[0] else \
-        float(np.max(np.abs(energy - energy[0] - work)))
+    # on the scale of the energy in play (a body at rest with its wheels has T0 = 0)
+    scale = max(float(np.max(np.abs(energy))), float(np.max(np.abs(work))))
+    residual = float(np.max(np.abs(energy - energy[0] - work)) / scale) if scale else 0.0
     ratio_l, ratio_e = max(momentum, direction) / tol.momentum, residual / tol.balance
     status = level(max(ratio_l, ratio_e))
     message = 'momentum exchanged, total H conserved' if status == OK else (
