@@ -209,22 +209,24 @@ def test_the_example_controller_flies_the_wheels_in_lockstep_as_offline(launch, 
     stepped with the held commands) gives the same state, bit for bit.
     """
     import os
-    from rigid_body_dynamics.physics import quaternions
     from rigid_body_dynamics.physics.control import fly_on_wheels, QuaternionPD, WheelAllocator
     import yaml
     params = os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples', 'wheels.yaml')
     launch(SIM, '--params-file', params, '-p', 'publish_clock:=true', '-p', 'lockstep:=true',
            '-p', 'lockstep_answer:=both', '-p', 'initial_angular_velocity:=[0.0, 0.0, 0.0]',
            '-p', 'qos_overrides./odom.publisher.depth:=10000', name='sim')
+    states = {}
+    probe.node.create_subscription(Odometry, 'odom',
+                                   lambda m: states.setdefault(time_ns(m.header.stamp), m), 10000)
+    # the probe hears the simulator before the controller starts it: lockstep then runs at
+    # 15x real time, and a probe that joined later saw only states after 3 s
+    probe.spin_until(lambda: 0 in states, 30.0, 'the state at t = 0')
     target = [math.sin(math.radians(15.0)), 0.0, 0.0, math.cos(math.radians(15.0))]
     launch('rigid_body_dynamics.nodes.controller', '--params-file', params,
            '-p', 'actuator:=wheels', '-p', f'target_orientation:={target}',
            '-p', 'natural_frequency:=0.5', name='controller')
-    states = {}
-    probe.node.create_subscription(Odometry, 'odom',
-                                   lambda m: states.setdefault(time_ns(m.header.stamp), m), 10000)
-    # (the probe may miss states under load: a reader does not hold the simulator back, so
-    # the check is at the latest tick state it has by 3 s)
+    # (the probe may still miss states under load: a reader does not hold the simulator
+    # back, so the check is at the latest tick state it has by 3 s)
     probe.spin_until(lambda: max(states, default=-1) >= 3_000_000_000, 120.0, '3 s in lockstep')
     check = max(t for t in states if t % 10_000_000 == 0 and 0 < t <= 3_000_000_000)
     with open(params) as f:
@@ -239,8 +241,8 @@ def test_the_example_controller_flies_the_wheels_in_lockstep_as_offline(launch, 
     _ticks, body = fly_on_wheels(moments, sim_wheels, law, WheelAllocator(ctl_wheels),
                                  check * 1e-9)
     _, q, w = odom_arrays([states[check]])
-    assert tuple(q[0]) == body.q and tuple(w[0]) == body.omega     # bit for bit
-    assert quaternions.angle_between(q[0], np.array(target)) < math.radians(30.0)  # on its way
+    # bit for bit (that loop's slew against the PD theory: test_gyrostat.py)
+    assert tuple(q[0]) == body.q and tuple(w[0]) == body.omega
 
 
 def test_a_fleet_body_with_wheels_beside_one_without(launch, probe, tmp_path):

@@ -286,6 +286,9 @@ class BodySimulation:
         self.wheels = wheels if wheels is not None and wheels.count else None
         n = self.wheels.count if self.wheels is not None else 0
         self.wheel_speeds0 = tuple(float(v) for v in wheel_speeds) if wheel_speeds else (0.0,) * n
+        self._no_motors = (0.0,) * n
+        self._wheel_friction = self.wheels is not None and bool(
+            any(self.wheels.coulomb) or any(self.wheels.viscous))
         self.wheel_counts = dict.fromkeys(WHEEL_COUNTS, 0)
         self.counts = dict.fromkeys(COUNTS, 0)
         self.notes = []
@@ -307,6 +310,7 @@ class BodySimulation:
             self.timed_out = False
             self.wheel_held = None
             self.wheel_timed_out = False
+            self._motors_given = None        # the motor torques the stepper holds
             self._held = (_ZERO, None, None)
             self.gyro = GyroModel(self.gyro_errors, self.rate / max(self.imu_every, 1),
                                   self.seed)     # same seed: the same stream after a reset
@@ -410,6 +414,7 @@ class BodySimulation:
                 old = self.stepper
                 self.stepper = self._make_stepper(old.q, old.omega, getattr(old, 'speeds', None),
                                                   getattr(old, 'angles', None))
+                self._motors_given = None            # the new stepper holds none yet
                 self._disturb()
                 self._baseline()
                 cmd = self.command_held
@@ -503,16 +508,27 @@ class BodySimulation:
         ``torque_timeout``; a note says so once). Call under ``lock``.
         """
         held = self.wheel_held
-        if held is None:
-            return (0.0,) * self.wheels.count
-        if self.timeout_ns and now_ns - held[1] > self.timeout_ns:
-            if not self.wheel_timed_out:
-                self.wheel_timed_out = True
-                self.notes.append('wheel command timed out: motor torques are zero until the '
-                                  'next wheel_cmd')
-            return (0.0,) * self.wheels.count
-        self.wheel_timed_out = False
+        if held is None or not self._in_force(
+                held[1], now_ns, 'wheel_timed_out',
+                'wheel command timed out: motor torques are zero until the next wheel_cmd'):
+            return self._no_motors
         return held[0]
+
+    def _in_force(self, received_ns, now_ns, flag, note):
+        """
+        Tell whether a command received at ``received_ns`` is still held: the watchdog.
+
+        Of the torque and of the motors: False once ``torque_timeout`` has passed
+        since ``received_ns``; the attribute ``flag`` says so, and ``note`` is
+        logged once per timeout. Call under ``lock``.
+        """
+        if self.timeout_ns and now_ns - received_ns > self.timeout_ns:
+            if not getattr(self, flag):
+                setattr(self, flag, True)
+                self.notes.append(note)
+            return False
+        setattr(self, flag, False)
+        return True
 
     def command(self, vector, world, now_ns, force=_ZERO, stamp_ns=None):
         """
@@ -557,15 +573,10 @@ class BodySimulation:
         ``lock``).
         """
         cmd = self.command_held
-        if cmd is None:
+        if cmd is None or not self._in_force(
+                cmd.received_ns, now_ns, 'timed_out',
+                'torque command timed out: torque is zero until the next command'):
             return _ZERO, None
-        if self.timeout_ns and now_ns - cmd.received_ns > self.timeout_ns:
-            if not self.timed_out:
-                self.timed_out = True
-                self.notes.append('torque command timed out: torque is zero until the next '
-                                  'command')
-            return _ZERO, None
-        self.timed_out = False
         if cmd.world:
             return _ZERO, cmd.vector
         return cmd.principal, None
@@ -590,10 +601,11 @@ class BodySimulation:
                    or torque[2])
         if self.wheels is not None:
             motors = self.motor_torques_now(now_ns)
-            self.stepper.command_motors(motors)
+            if motors is not self._motors_given:     # (checked once, when it was held)
+                self.stepper.command_motors(motors)
+                self._motors_given = motors
             # motor torques and friction change T (not H): no free-motion drift baseline
-            torqued = torqued or any(motors) or any(self.wheels.coulomb) or \
-                any(self.wheels.viscous)
+            torqued = torqued or self._wheel_friction or any(motors)
         if self._base_stale and not torqued:
             self._baseline()          # the state after the last step under torque
         self.stepper.step(torque, torque_world, field)

@@ -14,10 +14,10 @@ possible, lockstep, a fleet's bodies):
    (:meth:`~.body.BodySimulation.hold`), which counts them and holds the newest.
 
 A new kind of command is a new value class (with ``kind``, ``received_ns``,
-``stamps_ns``, ``__len__`` and ``select``) and its decoder, and the body's rule for
-it; the paces do not change. :class:`WheelCommands` (reaction-wheel motor torques)
-was added that way. :class:`Mailbox` is an inbox for code without ROS
-(tests, a Python controller in the same process).
+``stamps_ns``, ``__len__``, and ``select`` if it has stamps) and its decoder, and
+the body's rule for it; the paces do not change. :class:`WheelCommands`
+(reaction-wheel motor torques) was added that way. :class:`Mailbox` is an inbox
+for code without ROS (tests, a Python controller in the same process).
 """
 
 import threading
@@ -106,10 +106,6 @@ class Mailbox:
         """Block until something is queued or ``timeout`` s pass; whether something is."""
         return self._arrived.wait(timeout)
 
-    def wake(self):
-        """Wake a :meth:`wait` now (stopping)."""
-        self._arrived.set()
-
 
 class WheelCommands:
     """
@@ -117,17 +113,18 @@ class WheelCommands:
 
     ``received_ns``: steady-clock receive times (int ns, non-decreasing);
     ``torques``: N sequences, each meant to hold one motor torque per wheel (a
-    wrong length or a non-finite value is refused and counted by the body);
-    ``stamps_ns``: None (std_msgs/Float64MultiArray has no header).
+    wrong length or a non-finite value is refused and counted by the body). No
+    stamps (std_msgs/Float64MultiArray has no header), so nothing is ever
+    dropped as stale and no ``select`` is needed.
     """
 
     kind = 'wheels'
-    __slots__ = ('received_ns', 'torques', 'stamps_ns')
+    stamps_ns = None
+    __slots__ = ('received_ns', 'torques')
 
-    def __init__(self, received_ns, torques, stamps_ns=None):
+    def __init__(self, received_ns, torques):
         self.received_ns = received_ns
         self.torques = torques
-        self.stamps_ns = stamps_ns
         if len(torques) != len(received_ns):
             raise ValueError(f'{len(received_ns)} receive times, {len(torques)} commands: '
                              'lengths differ')
@@ -139,9 +136,3 @@ class WheelCommands:
 
     def __len__(self):
         return len(self.received_ns)
-
-    def select(self, keep):
-        """Return the commands where the boolean sequence ``keep`` is true, in order."""
-        index = [i for i, k in enumerate(keep) if k]
-        return WheelCommands([self.received_ns[i] for i in index],
-                             [self.torques[i] for i in index])

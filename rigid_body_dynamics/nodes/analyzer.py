@@ -39,13 +39,13 @@ from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
 from . import analyzer_diagnostics as diagnostics
+from .wheel_parameters import wheel_params, wheels_from
 from ..messages import samples
 from ..physics import Inertia
 from ..physics.analysis import analyse, Tolerances, Trajectory
-from ..physics.gyrostat import Wheels
 from ..ros import conversions as conv
 from ..ros.intake import Intake
-from ..ros.parameters import as_vector, ConfigurationError, number_list, Param, ParameterTable
+from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
 from ..ros.runner import run
 from ..ros.throttle import ThrottledWarnings
 
@@ -84,15 +84,7 @@ def _inertia(raw):
 
 def _wheels(values, out):
     """Cross-check: the wheels (out['wheels'], None without), with the reason if refused."""
-    out['wheels'] = None
-    if not out.get('wheel_axes'):
-        return
-    try:
-        out['wheels'] = Wheels(out['wheel_axes'], out.get('wheel_inertia') or (),
-                               coulomb=out.get('wheel_friction_coulomb'),
-                               viscous=out.get('wheel_friction_viscous'))
-    except ValueError as err:
-        raise ConfigurationError(str(err)) from None
+    out['wheels'] = wheels_from(out)
 
 
 #: The parameters of attitude_analyzer (the manual's table is made from this; test_docs checks).
@@ -130,20 +122,8 @@ PARAMETERS = ParameterTable([
     Param('diagnostic_period', 'double', 1.0, '1.0 s',
           'Period of the analysis and of /diagnostics (s, steady clock).', low=0.01,
           high=3600.0, read_only=True),
-    Param('wheel_axes', 'double[]', None, '[] (no wheels)',
-          "The simulated body's reaction wheels, as attitude_simulator's parameter of the "
-          'same name (3 numbers per wheel, body frame): with them and `wheel_state`, '
-          'conservation checks the total H and the energy with the motor work.',
-          read_only=True, convert=number_list('wheel_axes')),
-    Param('wheel_inertia', 'double[]', None, '[]',
-          "Spin-axis moment of each wheel (kg m^2), as attitude_simulator's.", read_only=True,
-          convert=number_list('wheel_inertia')),
-    Param('wheel_friction_coulomb', 'double[]', None, '[] (none)',
-          "Coulomb friction of each wheel (N m), as attitude_simulator's (for the energy "
-          'balance).', read_only=True, convert=number_list('wheel_friction_coulomb')),
-    Param('wheel_friction_viscous', 'double[]', None, '[] (none)',
-          "Viscous friction of each wheel (N m s), as attitude_simulator's.", read_only=True,
-          convert=number_list('wheel_friction_viscous')),
+    *wheel_params('wheel_axes', 'wheel_inertia', 'wheel_friction_coulomb',
+                  'wheel_friction_viscous'),
 ], cross_checks=(_wheels,))
 
 

@@ -38,11 +38,11 @@ from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
+from .wheel_parameters import wheel_params, wheels_from
 from ..physics.control import QuaternionPD, RateDamper, WheelAllocator
-from ..physics.gyrostat import Wheels
 from ..ros import conversions as conv
 from ..ros.intake import Intake
-from ..ros.parameters import as_vector, ConfigurationError, number_list, Param, ParameterTable
+from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
 from ..ros.runner import run
 from ..ros.state_publisher import LATCHED_QOS, STATE_QOS
 
@@ -64,10 +64,11 @@ def _allocator(values, out):
     out['allocator'] = None
     if out['actuator'] != 'wheels':
         return
+    wheels = wheels_from(out)
+    if wheels is None:
+        raise ConfigurationError('actuator wheels needs the wheels: set wheel_axes and '
+                                 'wheel_inertia')
     try:
-        wheels = Wheels(out.get('wheel_axes') or (), out.get('wheel_inertia') or (),
-                        max_torque=out.get('wheel_max_torque'),
-                        max_speed=out.get('wheel_max_speed'))
         out['allocator'] = WheelAllocator(wheels, out['dump_fraction'], out['dump_gain'])
     except ValueError as err:
         raise ConfigurationError(f'actuator wheels: {err}') from None
@@ -96,20 +97,7 @@ PARAMETERS = ParameterTable([
           "torque: the law's torque on torque_cmd; wheels: flown by the reaction wheels "
           '(wheel_cmd), torque_cmd carrying only the momentum dump.',
           choices=('torque', 'wheels'), read_only=True),
-    Param('wheel_axes', 'double[]', None, '[]',
-          "The body's reaction wheels, as attitude_simulator's parameter (3 numbers per "
-          'wheel, body frame; at least three wheels spanning space).', read_only=True,
-          convert=number_list('wheel_axes')),
-    Param('wheel_inertia', 'double[]', None, '[]',
-          "Spin-axis moment of each wheel (kg m^2), as attitude_simulator's.",
-          read_only=True, convert=number_list('wheel_inertia')),
-    Param('wheel_max_torque', 'double[]', None, '[] (no limit)',
-          'Motor torque limit of each wheel (N m): the motor torques are scaled down '
-          'together to stay within it.', read_only=True,
-          convert=number_list('wheel_max_torque')),
-    Param('wheel_max_speed', 'double[]', None, '[] (no limit)',
-          'Speed limit of each wheel (rad/s): dumping starts at dump_fraction of it.',
-          read_only=True, convert=number_list('wheel_max_speed')),
+    *wheel_params('wheel_axes', 'wheel_inertia', 'wheel_max_torque', 'wheel_max_speed'),
     Param('dump_fraction', 'double', 0.8, '0.8',
           'Momentum dumping starts when a wheel passes this fraction of its speed limit and '
           'stops when all are under half of it.', low=0.0, high=1.0, above_low=True,

@@ -225,38 +225,40 @@ class AttitudeSimulator(Node):
         self._pub_rtf = self.create_publisher(Float64, '~/real_time_factor', 10)
         # the integration thread takes its commands itself: no executor hop, no callback each
         self._intake = Intake(self)
+        # the command topics and their decoders (raws, steady receive times) -> command value
+        self._decoders = {'torque_cmd': self._decode_torques}
         self._intake.subscribe(WrenchStamped, 'torque_cmd', TORQUE_QOS, overridable=True)
-        self._commands = ('torque_cmd',)
         if self.body.wheels is not None:
             self._intake.subscribe(Float64MultiArray, 'wheel_cmd', TORQUE_QOS, overridable=True)
-            self._commands += ('wheel_cmd',)
+            self._decoders['wheel_cmd'] = decode_wheels
+        self._commands = tuple(self._decoders)
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
 
     # ------------------------------------------------------------------ torque
     def _inbox(self):
         """
-        Return the torque_cmd messages pending, decoded into command values (the pace's inbox).
+        Return the command messages pending, decoded into command values (the pace's inbox).
 
         Called by the integration thread at every wake (under the body's lock);
-        commands in an unknown frame are counted here, everything else is the
-        engine's (:meth:`BodySimulation.hold`).
+        one value per command topic with messages; everything after decoding is
+        the engine's (:meth:`BodySimulation.check`, :meth:`BodySimulation.hold`).
         """
         out = []
-        received = []
-        raws = self._intake.take('torque_cmd', received=received)
-        if raws:
-            commands, refused = self._decoder.decode(raws, steady_times(received))
-            for frame, count in refused.items():
-                self._refused_frame = frame
-                self.body.reject('rejected_frame', count)
-            out.append(commands)
-        if len(self._commands) > 1:
+        for topic, decode in self._decoders.items():
             received = []
-            raws = self._intake.take('wheel_cmd', received=received)
+            raws = self._intake.take(topic, received=received)
             if raws:
-                out.append(decode_wheels(raws, steady_times(received)))
+                out.append(decode(raws, steady_times(received)))
         return out
+
+    def _decode_torques(self, raws, received_ns):
+        """Decode torque_cmd messages; those in an unknown frame are counted here."""
+        commands, refused = self._decoder.decode(raws, received_ns)
+        for frame, count in refused.items():
+            self._refused_frame = frame
+            self.body.reject('rejected_frame', count)
+        return commands
 
     def _warn_events(self, events):
         """Warn (throttled) about the command events the body reported."""

@@ -8,12 +8,13 @@ cross-checks below give every refusal its reason.
 
 import math
 
+from .wheel_parameters import WHEEL_PARAMS, wheel_params, wheels_from
 from ..engine import Disturbances
 from ..physics import Inertia, INTEGRATORS, presets
 from ..physics.disturbances import GravityGradient
-from ..physics.gyrostat import GyrostatIntegrator, MAX_WHEELS, Wheels
+from ..physics.gyrostat import GyrostatIntegrator
 from ..physics.integrators import REMOVED as REMOVED_INTEGRATORS
-from ..ros.parameters import as_vector, ConfigurationError, number_list, Param, ParameterTable
+from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
 from ..ros.state_publisher import OPTIONAL_TOPICS
 
 
@@ -98,25 +99,13 @@ def _disturbances(values, out):
         out['gravity_gradient_orbit_rate'], out['orbit_normal'], out['orbit_nadir'])
 
 
-#: The wheel parameters besides wheel_axes, and the Wheels field each fills.
-WHEEL_PARAMETERS = {'wheel_inertia': 'inertia', 'wheel_max_torque': 'max_torque',
-                    'wheel_max_speed': 'max_speed', 'wheel_friction_coulomb': 'coulomb',
-                    'wheel_friction_viscous': 'viscous'}
-
-
 def _wheels(values, out):
     """Cross-check: the wheels (out['wheels'], None without) and their initial speeds."""
-    axes = out.get('wheel_axes') or ()
-    given = [name for name in (*WHEEL_PARAMETERS, 'initial_wheel_speed') if out.get(name)]
+    wheels = wheels_from(out)
     out['wheels'] = out['wheel_speeds'] = None
-    if not axes:
-        if given:
-            raise ConfigurationError(f'{", ".join(given)} set but wheel_axes is empty: declare '
-                                     'the wheels with wheel_axes (3 numbers per wheel)')
+    if wheels is None:
         return
     try:
-        wheels = Wheels(axes, **{field: out.get(name) or () for name, field in
-                                 WHEEL_PARAMETERS.items()})
         # the body less its wheels' spin inertia must stay positive definite
         GyrostatIntegrator(out['body'].moments, wheels.turned(
             lambda g: out['body'].to_principal(g)), 1.0)
@@ -269,31 +258,7 @@ PARAMETERS = ParameterTable([
     Param('noise_seed', 'int', 0, '0',
           'Seed of the gyro noise: the same seed and parameters give the same imu stream, bit '
           'for bit (also after ~/reset).', low=0, high=2 ** 31 - 1, read_only=True),
-    Param('wheel_axes', 'double[]', None, '[] (no wheels)',
-          f'Reaction wheels: spin axis of each, 3 numbers per wheel (body frame, unit '
-          f'vectors), at most {MAX_WHEELS} wheels; [] = none. With wheels the body is a '
-          'gyrostat: the inertia above is the whole body with the wheels locked.',
-          read_only=True, convert=number_list('wheel_axes')),
-    Param('wheel_inertia', 'double[]', None, '[]',
-          'Spin-axis moment J of each wheel (kg m^2, > 0).', read_only=True,
-          convert=number_list('wheel_inertia')),
-    Param('wheel_max_torque', 'double[]', None, '[] (no limit)',
-          'Motor torque limit of each wheel (N m; 0 = none): larger commands are clipped and '
-          'counted.', read_only=True, convert=number_list('wheel_max_torque')),
-    Param('wheel_max_speed', 'double[]', None, '[] (no limit)',
-          'Speed limit of each wheel (rad/s relative to the body; 0 = none): at or beyond it '
-          'a command that would speed the wheel up is cut to 0 and counted.', read_only=True,
-          convert=number_list('wheel_max_speed')),
-    Param('wheel_friction_coulomb', 'double[]', None, '[] (none)',
-          'Coulomb friction of each wheel (N m), c tanh(Omega / 0.1 rad/s): smoothed near rest '
-          'so it does not chatter.', read_only=True,
-          convert=number_list('wheel_friction_coulomb')),
-    Param('wheel_friction_viscous', 'double[]', None, '[] (none)',
-          'Viscous friction of each wheel (N m s).', read_only=True,
-          convert=number_list('wheel_friction_viscous')),
-    Param('initial_wheel_speed', 'double[]', None, '[] (all 0)',
-          'Wheel speeds (rad/s relative to the body) at start and on ~/reset.', read_only=True,
-          convert=number_list('initial_wheel_speed')),
+    *wheel_params(*WHEEL_PARAMS),
 ], cross_checks=(_body, _publish_rate, _imu_rate, _control_steps, _disturbances, _wheels,
                  _lockstep_answer))
 

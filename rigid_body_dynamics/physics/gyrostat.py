@@ -39,6 +39,7 @@ import math
 from . import dop853_tableau
 from .quaternions import rotate_components
 
+_ZERO = (0.0, 0.0, 0.0)
 #: Speed (rad/s) over which the Coulomb friction fades to zero at rest (tanh width).
 FRICTION_SMOOTHING = 0.1
 #: Most wheels a body may carry.
@@ -199,6 +200,9 @@ class GyrostatIntegrator:
                 for k in range(3):
                     locked[r][k] -= j * g[r] * g[k]
         self._a_inv = _inverse3(tuple(tuple(row) for row in locked))
+        # (the step's hot path: no tanh per wheel and stage for wheels without friction)
+        self._friction = wheels.friction if any(wheels.coulomb) or any(wheels.viscous) \
+            else (lambda speeds, zeros=(0.0,) * wheels.count: zeros)
         self.commanded = (0.0,) * wheels.count
         self.reset(q0, omega0, speeds0)
 
@@ -288,7 +292,7 @@ class GyrostatIntegrator:
         i1, i2, i3 = self.moments
         hx, hy, hz = i1 * w1, i2 * w2, i3 * w3
         rx, ry, rz = tx, ty, tz
-        friction = self.wheels.friction(speeds)
+        friction = self._friction(speeds)
         nets, motor, loss = [], 0.0, 0.0
         for (gx, gy, gz), j, s, u, fr in zip(self.wheels.axes, self.wheels.inertia, speeds,
                                              applied, friction):
@@ -311,7 +315,7 @@ class GyrostatIntegrator:
         dy += [net / j - (g[0] * d1 + g[1] * d2 + g[2] * d3)
                for net, j, g in zip(nets, self.wheels.inertia, self.wheels.axes)]
         dy += list(speeds)
-        world = rotate_components((qx, qy, qz, qw), (tx, ty, tz))
+        world = rotate_components((qx, qy, qz, qw), (tx, ty, tz)) if tx or ty or tz else _ZERO
         return dy, (w1 * tx + w2 * ty + w3 * tz, motor, loss, world)
 
     def step(self, torque=(0.0, 0.0, 0.0), torque_world=None, field=None):
