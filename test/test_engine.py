@@ -39,7 +39,7 @@ def make_body(**kwargs):
 
 def test_the_physics_the_engine_and_the_messages_import_no_ros():
     code = ('import sys, rigid_body_dynamics.physics, rigid_body_dynamics.engine; '
-            'import rigid_body_dynamics.physics.disturbances; '
+            'import rigid_body_dynamics.physics.environment; '
             'import rigid_body_dynamics.physics.findings_render; '
             'import rigid_body_dynamics.messages.bags, rigid_body_dynamics.messages.cdr; '
             'print(sorted(m for m in sys.modules if m == "rclpy" or m.startswith('
@@ -393,24 +393,28 @@ def test_lockstep_publishes_the_tick_state_when_it_is_not_a_publish_tick():
 def test_disturbances_are_summed_into_the_integrated_and_reported_torque():
     """Constant body and world disturbances and the gravity gradient, against the integrator."""
     from rigid_body_dynamics.engine import Disturbances
-    from rigid_body_dynamics.physics.disturbances import GravityGradient
-    d = Disturbances(body=(0.01, 0.0, 0.0), world=(0.0, 0.0, 0.02), orbit_rate=0.05,
-                     orbit_normal=(0.0, 0.0, 1.0), nadir0=(1.0, 0.0, 0.0))
+    from rigid_body_dynamics.physics.environment import (GravityGradient, KeplerOrbit,
+                                                         SpaceEnvironment)
+    orbit = KeplerOrbit((1.0, 0.0, 0.3, 0.0, 0.0, 0.0), mu=0.0025, planet_radius=0.0)  # n 0.05
+    d = Disturbances(body=(0.01, 0.0, 0.0), world=(0.0, 0.0, 0.02), orbit=orbit,
+                     gravity_gradient=True)
     body, outbox = make_body(disturbances=d, publish_every=50), []
     body.command((0.0, 0.1, 0.0), False, now_ns=0)
     with body.lock:
         for _ in range(100):
             body.advance(now_ns=0, outbox=outbox)
-    gg = GravityGradient((1.0, 2.0, 3.0), 0.05, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+    gg = SpaceEnvironment(orbit, None, [GravityGradient((1.0, 2.0, 3.0), 0.0025)])
     ref = make_integrator('exact', (1.0, 2.0, 3.0), 1e-3, (0.0, 0.0, 0.0, 1.0), (0.3, 1.5, -0.4))
     for _ in range(100):
         ref.step((0.01, 0.1, 0.0), (0.0, 0.0, 0.02), gg)
     assert body.stepper.q == ref.q and body.stepper.omega == ref.omega
     q = ref.q
     world = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), (0.0, 0.0, 0.02))
-    expected = np.array((0.01, 0.1, 0.0)) + world + gg(0.1, *q)
+    expected = np.array((0.01, 0.1, 0.0)) + world + gg(0.1, *q, *ref.omega)
     np.testing.assert_allclose(outbox[-1].torque_principal, expected, rtol=0, atol=1e-17)
-    # an integrator change mid-run keeps the orbit's clock (the field's epoch)
+    # the snapshot carries the orbit's position and velocity at its time
+    assert outbox[-1].position == orbit.state(0.1)
+    # an integrator change mid-run keeps the orbit's clock (the environment's epoch)
     with body.lock:
         body.configure(integrator='rk4')
         assert body._field.epoch == pytest.approx(0.1)

@@ -12,8 +12,14 @@ Frames: the body frame is the user's (the inertia's); the state is kept in
 the principal frame of the inertia. Torques in N m, body frame, or world frame
 for a command given in the world frame (rotated into the body at every RK
 stage by the integrator). :class:`Disturbances` are summed into the torque
-that is integrated (and reported in snapshots), the gravity gradient
+that is integrated (and reported in snapshots): the constant ones held over
+each step, the environment's torque models (gravity gradient, residual
+dipole, magnetorquers: :mod:`rigid_body_dynamics.physics.environment`)
 evaluated at every RK stage.
+
+Ticks. Every item a body puts out (the state, the gyro's and the
+magnetometer's samples) comes every whole number of steps; :meth:`BodySimulation.ticks`
+is that one schedule, which the paces read (:meth:`BodySimulation.steps_to_tick`).
 """
 
 from dataclasses import dataclass
@@ -23,11 +29,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .commands import TorqueCommands
+from .commands import DipoleCommands, TorqueCommands
 from ..physics import make_integrator, quaternions
-from ..physics.disturbances import GravityGradient
+from ..physics.environment import (GravityGradient, MagneticDipole, Magnetorquers,
+                                   SpaceEnvironment)
 from ..physics.gyrostat import GyrostatIntegrator
-from ..physics.sensors import GyroErrors, GyroModel
+from ..physics.sensors import GyroErrors, GyroModel, Magnetometer
 
 _ZERO = (0.0, 0.0, 0.0)
 _NS = 1_000_000_000
@@ -37,6 +44,8 @@ COUNTS = ('accepted', 'rejected_non_finite', 'rejected_frame', 'clipped', 'force
           'stale')
 #: Counters of wheel commands (wheel_cmd), in the order diagnostics list them.
 WHEEL_COUNTS = ('accepted', 'rejected')
+#: Counters of magnetorquer commands (magnetorquer_cmd), in the order diagnostics list them.
+DIPOLE_COUNTS = ('accepted', 'rejected_non_finite', 'rejected_frame', 'clipped', 'stale')
 
 
 @dataclass(frozen=True)
@@ -53,25 +62,36 @@ class TorqueCommand:
 @dataclass(frozen=True)
 class Disturbances:
     """
-    Disturbance torques, summed into the commanded torque (N m).
+    The environment and its disturbance torques, summed into the commanded torque (N m).
 
     ``body``: constant in the body frame; ``world``: constant in the world
-    frame; ``orbit_rate`` n (rad/s, 0 = none): the gravity gradient of a
-    circular orbit about the world unit vector ``orbit_normal`` with nadir
-    along ``nadir0`` (world) at simulated time 0
-    (:class:`~rigid_body_dynamics.physics.disturbances.GravityGradient`).
+    frame; ``orbit``: a :class:`~rigid_body_dynamics.physics.environment.KeplerOrbit`
+    (None = no orbit); ``field``: a
+    :class:`~rigid_body_dynamics.physics.environment.DipoleField` (None = none);
+    ``gravity_gradient``: its torque on the orbit; ``residual_dipole`` (A m^2,
+    body frame): the torque m x B in the field.
     """
 
     body: tuple = _ZERO
     world: tuple = _ZERO
-    orbit_rate: float = 0.0
-    orbit_normal: tuple = (0.0, 0.0, 1.0)
-    nadir0: tuple = (1.0, 0.0, 0.0)
+    orbit: object = None
+    field: object = None
+    gravity_gradient: bool = False
+    residual_dipole: tuple = _ZERO
 
     @property
     def active(self):
-        """Whether any disturbance acts."""
-        return bool(any(self.body) or any(self.world) or self.orbit_rate)
+        """Whether any disturbance torque acts."""
+        return bool(any(self.body) or any(self.world) or self.gravity_gradient
+                    or any(self.residual_dipole))
+
+    def __str__(self):
+        parts = [f'{name} {value}' for name, value in (
+            ('body torque', self.body), ('world torque', self.world),
+            ('residual dipole', self.residual_dipole)) if any(value)]
+        if self.gravity_gradient:
+            parts.append('gravity gradient')
+        return ', '.join(parts) or 'none'
 
 
 class ImuSample(NamedTuple):
@@ -90,6 +110,18 @@ class ImuSample(NamedTuple):
     bias_body: tuple
     rate_variance: float
     orientation_variance: float
+
+
+class MagneticSample(NamedTuple):
+    """
+    One magnetometer reading: ``stamp_ns``, ``field_body`` (T, the user's body frame).
+
+    ``variance`` (T^2 per axis) is the white noise's, for the message covariance.
+    """
+
+    stamp_ns: int
+    field_body: tuple
+    variance: float
 
 
 class WheelState(NamedTuple):
@@ -127,6 +159,8 @@ class Snapshot(NamedTuple):
     inertia: object
     odom_only: bool = False    # lockstep's tick state between publish ticks: odom (and clock, TF)
     wheels: object = None      # a WheelState when the body has reaction wheels
+    position: object = None    # (r m, v m/s) in the world frame, with an orbit
+    dipole: object = None      # the magnetorquers' dipole (A m^2, body frame) over the last step
 
 
 #: Up to this many commands are checked one by one in plain Python, more as arrays: numpy's
@@ -136,9 +170,11 @@ CHECK_ARRAYS_FROM = 8
 
 class CheckedTorques:
     """
-    Torque commands checked at once, for the body to count and hold in slices.
+    Torque (or magnetorquer dipole) commands checked at once, for the body to count and hold.
 
-    Made by :meth:`BodySimulation.check`, read by :meth:`BodySimulation.hold`.
+    Made by :meth:`BodySimulation.check`, read by :meth:`BodySimulation.hold`;
+    ``kind`` is the commands' ('torque' or 'dipole'), ``limits`` the per-axis
+    limits (0 = none).
     Plain data: the clipped vectors, each command's frame, the running counts of
     refused, clipped and force-carrying commands before each index, and the
     newest finite index at or before each. So a flood of N commands costs one
@@ -146,31 +182,31 @@ class CheckedTorques:
     integer operations.
     """
 
-    kind = 'torque'
-
-    def __init__(self, commands, max_torque):
+    def __init__(self, commands, limits):
+        self.kind = commands.kind
         self.received_ns = commands.received_ns
         self.stamps_ns = commands.stamps_ns
         self.world_of = commands.world_of
         check = _check_each if len(commands) < CHECK_ARRAYS_FROM else _check_arrays
         # the clipped vectors; counts of commands before index i that were refused, clipped,
         # carried a force; the newest finite index at or before i
-        self.vectors, self.bad, self.over, self.pushed, self.newest = check(commands, max_torque)
+        self.vectors, self.bad, self.over, self.pushed, self.newest = check(commands, limits)
 
     def __len__(self):
         return len(self.received_ns)
 
 
-def _check_each(commands, limit):
+def _check_each(commands, limits):
     """(vectors, bad, over, pushed, newest) of :class:`CheckedTorques`, one by one in Python."""
     vectors, bad, over, pushed, newest = [], [0], [0], [0], []
     forces, last = commands.forces, -1
+    limited = any(limits)
     for i, torque in enumerate(commands.torques):
         v = [float(c) for c in torque]
         ok = all(math.isfinite(c) for c in v)
-        clip = ok and limit > 0.0 and any(abs(c) > limit for c in v)
+        clip = ok and limited and any(0.0 < top < abs(c) for c, top in zip(v, limits))
         if clip:
-            v = [min(max(c, -limit), limit) for c in v]
+            v = [min(max(c, -top), top) if top > 0.0 else c for c, top in zip(v, limits)]
         f = forces[i] if forces is not None else None
         push = ok and f is not None and any(not math.isfinite(c) or c != 0.0 for c in f)
         vectors.append(v)
@@ -182,14 +218,15 @@ def _check_each(commands, limit):
     return vectors, bad, over, pushed, newest
 
 
-def _check_arrays(commands, limit):
+def _check_arrays(commands, limits):
     """As :func:`_check_each`, over (N, 3) arrays at once."""
     v = np.asarray(commands.torques, dtype=float).reshape(-1, 3)
     n = len(v)
     finite = np.all(np.isfinite(v), axis=1)
-    if limit > 0.0:
-        over = finite & np.any(np.abs(v) > limit, axis=1)
-        v = np.clip(v, -limit, limit)
+    if any(limits):
+        top = np.array([c if c > 0.0 else np.inf for c in limits])
+        over = finite & np.any(np.abs(v) > top, axis=1)
+        v = np.clip(v, -top, top)
     else:
         over = np.zeros(n, dtype=bool)
     if commands.forces is not None:
@@ -246,7 +283,12 @@ class BodySimulation:
     :class:`~rigid_body_dynamics.physics.gyrostat.Wheels` in the body frame, or None)
     and their ``wheel_speeds`` at the start (rad/s; default 0): with wheels the body is
     a gyrostat and its motor torques are commands of their own (``WheelCommands``),
-    held and timed out like the torque. ``notes`` collects what a node should
+    held and timed out like the torque. ``magnetorquers`` (A m^2 per body axis, 0 =
+    no limit; None = no magnetorquers) makes the dipole a command too
+    (``DipoleCommands``, body frame, clipped per axis, held and timed out like
+    the torque; its torque m x B acts through the environment's field).
+    ``magnetometer`` = (noise T, bias T body) samples the field every
+    ``magnetometer_every`` steps (0 = none). ``notes`` collects what a node should
     log (the watchdog's timeouts, lockstep's misses), drained with
     :meth:`take_notes`; ``events`` the command events since the last
     :meth:`take_events` (for the node's warnings).
@@ -267,7 +309,8 @@ class BodySimulation:
 
     def __init__(self, inertia, integrator, rate, initial, torque_timeout=0.5, max_torque=0.0,
                  publish_every=1, start_ns=0, imu_every=0, gyro=None, seed=0,
-                 disturbances=None, wheels=None, wheel_speeds=None):
+                 disturbances=None, wheels=None, wheel_speeds=None, magnetorquers=None,
+                 magnetometer=None, magnetometer_every=0):
         self.lock = threading.RLock()
         self.rate = float(rate)
         self.dt = 1.0 / self.rate
@@ -291,8 +334,13 @@ class BodySimulation:
             any(self.wheels.coulomb) or any(self.wheels.viscous))
         self.wheel_counts = dict.fromkeys(WHEEL_COUNTS, 0)
         self.counts = dict.fromkeys(COUNTS, 0)
+        self.max_dipole = None if magnetorquers is None else tuple(float(c) for c in magnetorquers)
+        self.dipole_counts = dict.fromkeys(DIPOLE_COUNTS, 0)
+        self.magnetometer_config = magnetometer
+        self.magnetometer_every = int(magnetometer_every) if magnetometer is not None else 0
         self.notes = []
         self.events = set()
+        self._schedule = self._make_schedule()
         self.reset()
 
     # ------------------------------------------------------------------ state
@@ -310,10 +358,15 @@ class BodySimulation:
             self.timed_out = False
             self.wheel_held = None
             self.wheel_timed_out = False
+            self.dipole_held = None          # (body vector, received_ns, stamp_ns)
+            self.dipole_timed_out = False
             self._motors_given = None        # the motor torques the stepper holds
+            self._dipole_given = _ZERO       # the dipole (body) the environment holds
             self._held = (_ZERO, None, None)
             self.gyro = GyroModel(self.gyro_errors, self.rate / max(self.imu_every, 1),
                                   self.seed)     # same seed: the same stream after a reset
+            self.magnetometer = None if self.magnetometer_config is None else Magnetometer(
+                *self.magnetometer_config, seed=self.seed)
             self._disturb()
             self._baseline()
 
@@ -341,10 +394,26 @@ class BodySimulation:
         self._dist_body = tuple(float(c) for c in body.to_principal(np.array(d.body))) \
             if any(d.body) else None
         self._dist_world = tuple(float(c) for c in d.world) if any(d.world) else None
-        # the stepper's time starts at 0 when it is made: the field is told the offset
-        self._field = GravityGradient(body.moments, d.orbit_rate, d.orbit_normal, d.nadir0,
-                                      epoch=(self.steps - self.stepper.steps) * self.dt) \
-            if d.orbit_rate else None
+        models = []
+        if d.gravity_gradient:
+            models.append(GravityGradient(body.moments, d.orbit.mu))
+        if any(d.residual_dipole):
+            models.append(MagneticDipole(self._principal(d.residual_dipole)))
+        self._magnetorquers = None
+        if any(self._dipole_given):
+            self._magnetorquers = Magnetorquers()
+            self._magnetorquers.set_dipole(self._principal(self._dipole_given))
+            models.append(self._magnetorquers)
+        # the stepper's time starts at 0 when it is made: the environment is told the offset
+        self._field = SpaceEnvironment(
+            d.orbit, d.field, models, epoch=(self.steps - self.stepper.steps) * self.dt) \
+            if models else None
+
+    def _principal(self, vector):
+        """Return a body-frame vector in the principal frame, as a tuple of floats."""
+        if self.inertia.is_principal_frame:
+            return tuple(float(c) for c in vector)
+        return tuple(float(c) for c in self.inertia.to_principal(np.array(vector)))
 
     def _baseline(self):
         """Remember T and L_w now: drift is reported since the last torque or change."""
@@ -393,6 +462,7 @@ class BodySimulation:
                 self.max_torque = float(max_torque)
             if publish_every is not None:
                 self.publish_every = int(publish_every)
+                self._schedule = self._make_schedule()
             if disturbances is not None and disturbances != self.disturbances:
                 self.disturbances = disturbances
                 self._disturb()
@@ -441,7 +511,11 @@ class BodySimulation:
         """
         with self.lock:
             if commands.kind == 'torque':
-                return CheckedTorques(commands, self.max_torque)
+                return CheckedTorques(commands, (self.max_torque,) * 3)
+            if commands.kind == 'dipole':
+                if self.max_dipole is None:
+                    raise ValueError('this body has no magnetorquers')
+                return CheckedTorques(commands, self.max_dipole)
             if commands.kind == 'wheels':
                 return CheckedWheels(commands, self.wheels.count if self.wheels else 0)
             raise ValueError(f'unknown kind of command {commands.kind!r}')
@@ -459,28 +533,34 @@ class BodySimulation:
         if checked.kind == 'wheels':
             return self._hold_wheels(checked, start, stop)
         events = set()
+        dipole = checked.kind == 'dipole'     # (events of the dipole say so: 'dipole_clipped')
+        counts, prefix = (self.dipole_counts, 'dipole_') if dipole else (self.counts, '')
         with self.lock:
-            counts = self.counts
             bad = checked.bad[stop] - checked.bad[start]
             if bad:
                 counts['rejected_non_finite'] += bad
-                events.add('rejected_non_finite')
+                events.add(prefix + 'rejected_non_finite')
             good = stop - start - bad
             if good:
                 over = checked.over[stop] - checked.over[start]
                 if over:
                     counts['clipped'] += over
-                    events.add('clipped')
+                    events.add(prefix + 'clipped')
                 pushed = checked.pushed[stop] - checked.pushed[start]
                 if pushed:
                     counts['force_ignored'] += pushed
                     events.add('force_ignored')
                 counts['accepted'] += good
-                events.add('accepted')
+                events.add(prefix + 'accepted')
                 i = checked.newest[stop - 1]
-                self.command_held = self._make_command(
-                    tuple(checked.vectors[i]), checked.world_of(i), checked.received_ns[stop - 1],
-                    None if checked.stamps_ns is None else checked.stamps_ns[i])
+                stamp = None if checked.stamps_ns is None else checked.stamps_ns[i]
+                if dipole:
+                    self.dipole_held = (tuple(checked.vectors[i]), checked.received_ns[stop - 1],
+                                        stamp)
+                else:
+                    self.command_held = self._make_command(
+                        tuple(checked.vectors[i]), checked.world_of(i),
+                        checked.received_ns[stop - 1], stamp)
             self.events |= events
         return events
 
@@ -514,6 +594,29 @@ class BodySimulation:
             return self._no_motors
         return held[0]
 
+    def dipole_now(self, now_ns):
+        """
+        Return the held magnetorquer dipole (A m^2, body frame) for the next step, or zero.
+
+        Its watchdog is the torque's (``torque_timeout``; a note says so once).
+        Call under ``lock``.
+        """
+        held = self.dipole_held
+        if held is None or not self._in_force(
+                held[1], now_ns, 'dipole_timed_out',
+                'magnetorquer command timed out: the dipole is zero until the next '
+                'magnetorquer_cmd'):
+            return _ZERO
+        return held[0]
+
+    def held_stamp(self, kind):
+        """Return the header stamp (int ns or None) of the held command of ``kind``."""
+        if kind == 'torque':
+            return None if self.command_held is None else self.command_held.stamp_ns
+        if kind == 'dipole':
+            return None if self.dipole_held is None else self.dipole_held[2]
+        return None
+
     def _in_force(self, received_ns, now_ns, flag, note):
         """
         Tell whether a command received at ``received_ns`` is still held: the watchdog.
@@ -542,15 +645,20 @@ class BodySimulation:
         one = TorqueCommands.one(vector, world, now_ns, stamp_ns, force)
         return self.hold(self.check(one), 0, 1)
 
-    def reject(self, reason, count=1):
+    def reject(self, reason, count=1, kind='torque'):
         """
-        Count ``count`` commands refused before they were held; the reason is also an event.
+        Count ``count`` commands of ``kind`` refused before they were held; also an event.
 
-        E.g. 'rejected_frame' (the decoder) or 'stale' (lockstep). Takes the lock.
+        E.g. 'rejected_frame' (the decoder) or 'stale' (lockstep); a dipole
+        command's event is prefixed 'dipole_'. Takes the lock.
         """
         with self.lock:
-            self.counts[reason] += count
-            self.events.add(reason)
+            if kind == 'dipole':
+                self.dipole_counts[reason] += count
+                self.events.add('dipole_' + reason)
+            else:
+                self.counts[reason] += count
+                self.events.add(reason)
 
     def note(self, text):
         """Add a line for the node's log (:meth:`take_notes`). Takes the lock."""
@@ -596,6 +704,11 @@ class BodySimulation:
         if self._dist_world is not None:
             torque_world = self._dist_world if torque_world is None else tuple(
                 a + b for a, b in zip(torque_world, self._dist_world))
+        if self.max_dipole is not None:
+            dipole = self.dipole_now(now_ns)
+            if dipole is not self._dipole_given:      # (a new command, or its timeout)
+                self._dipole_given = dipole
+                self._disturb()
         field = self._field
         torqued = (field is not None or torque_world is not None or torque[0] or torque[1]
                    or torque[2])
@@ -615,12 +728,31 @@ class BodySimulation:
         self._held = (torque, torque_world, field)
         self._ticks(outbox)
 
+    def _make_schedule(self):
+        """Return the ticks: (steps per item, the method that takes the item), state first."""
+        schedule = [(self.publish_every, self.snapshot)]
+        if self.imu_every:
+            schedule.append((self.imu_every, self.imu_sample))
+        if self.magnetometer_every:
+            schedule.append((self.magnetometer_every, self.magnetometer_sample))
+        return schedule
+
+    @property
+    def shortest_tick(self):
+        """Return the fewest steps between two items of the schedule."""
+        return min(every for every, _ in self._schedule)
+
+    def steps_to_tick(self):
+        """Return the steps from now to the next item of the schedule (1 .. shortest_tick)."""
+        steps = self.steps
+        return min(every - steps % every for every, _ in self._schedule)
+
     def _ticks(self, outbox):
-        """Put the current step's snapshot and IMU sample in ``outbox`` if it is their tick."""
-        if self.steps % self.publish_every == 0:
-            outbox.append(self.snapshot())
-        if self.imu_every and self.steps % self.imu_every == 0:
-            outbox.append(self.imu_sample())
+        """Put the items due at the current step (state, sensor samples) in ``outbox``."""
+        steps = self.steps
+        for every, take in self._schedule:
+            if steps % every == 0:
+                outbox.append(take())
 
     def advance_free(self, count, now_ns, outbox):
         """
@@ -640,16 +772,13 @@ class BodySimulation:
             self.torque_now(now_ns)            # the watchdog, as the first step would ask it
             if not self.timed_out:
                 return False
+        if self.dipole_held is not None and any(self.dipole_now(now_ns)):
+            return False
         if self._base_stale:
             self._baseline()                   # the state after the last step under torque
         self._held = (_ZERO, None, None)
-        publish, imu = self.publish_every, self.imu_every
         while count > 0:
-            steps = self.steps
-            run = publish - steps % publish
-            if imu:
-                run = min(run, imu - steps % imu)
-            run = min(run, count)
+            run = min(self.steps_to_tick(), count)
             self.stepper.free_steps(run)
             self.steps += run
             count -= run
@@ -657,11 +786,8 @@ class BodySimulation:
         return True
 
     def first_items(self):
-        """Return the items of time 0 (call under ``lock``): the state, and an IMU sample."""
-        items = [self.snapshot()]
-        if self.imu_every:
-            items.append(self.imu_sample())
-        return items
+        """Return the items of time 0 (call under ``lock``): the state and sensor samples."""
+        return [take() for _, take in self._schedule]
 
     def imu_sample(self):
         """Sample the gyro at the current state (call under ``lock``): an :class:`ImuSample`."""
@@ -669,6 +795,16 @@ class BodySimulation:
         q, measured, bias = gyro.read(*self.body_state())
         return ImuSample(self.stamp_now(), q, measured, bias,
                          gyro.rate_variance, gyro.orientation_variance)
+
+    def magnetometer_sample(self):
+        """Read the magnetometer at the current state (call under ``lock``): a MagneticSample."""
+        d = self.disturbances
+        t = self.steps * self.dt
+        b_world = d.field.world(t, d.orbit.position(t))
+        q = self.body_state()[0]
+        b_body = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), b_world)
+        m = self.magnetometer
+        return MagneticSample(self.stamp_now(), m.read(b_body), m.variance)
 
     def stamp_now(self):
         """Return the stamp (int ns) of the current simulated time."""
@@ -690,7 +826,7 @@ class BodySimulation:
             w = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), torque_world)
             torque = (torque[0] + w[0], torque[1] + w[1], torque[2] + w[2])
         if field is not None:
-            f = field(self.stepper.time, *q)
+            f = field(self.stepper.time, *q, *self.stepper.omega)
             torque = (torque[0] + f[0], torque[1] + f[1], torque[2] + f[2])
         return torque
 
@@ -699,8 +835,11 @@ class BodySimulation:
         s = self.stepper
         wheels = None if self.wheels is None else WheelState(
             s.speeds, s.angles, s.applied, s.wheel_momentum_body)
+        orbit = self.disturbances.orbit
         return Snapshot(self.stamp_now(), self.steps, s.q, s.omega,
-                        self.last_torque, self.inertia, odom_only, wheels)
+                        self.last_torque, self.inertia, odom_only, wheels,
+                        None if orbit is None else orbit.state(self.steps * self.dt),
+                        None if self.max_dipole is None else self._dipole_given)
 
     # ------------------------------------------------------------------ diagnostics
     def health(self):
@@ -728,7 +867,10 @@ class BodySimulation:
                                               float(np.dot(l0, l1))),
                 'work': s.work, 'command': self.command_held, 'timed_out': self.timed_out,
                 'paused': self.paused, 'counts': dict(self.counts),
-                'wheels': None if self.wheels is None else self._wheel_health()}
+                'wheels': None if self.wheels is None else self._wheel_health(),
+                'magnetorquers': None if self.max_dipole is None else {
+                    'dipole': self._dipole_given, 'command': self.dipole_held,
+                    'timed_out': self.dipole_timed_out, 'counts': dict(self.dipole_counts)}}
 
     def _wheel_health(self):
         """Return the wheels' numbers for diagnostics (call under ``lock``)."""

@@ -16,7 +16,8 @@ possible, lockstep, a fleet's bodies):
 A new kind of command is a new value class (with ``kind``, ``received_ns``,
 ``stamps_ns``, ``__len__``, and ``select`` if it has stamps) and its decoder, and
 the body's rule for it; the paces do not change. :class:`WheelCommands`
-(reaction-wheel motor torques) was added that way. :class:`Mailbox` is an inbox
+(reaction-wheel motor torques) and :class:`DipoleCommands` (magnetorquers) were
+added that way. :class:`Mailbox` is an inbox
 for code without ROS (tests, a Python controller in the same process).
 """
 
@@ -74,6 +75,35 @@ class TorqueCommands:
         world = self.world if isinstance(self.world, bool) else pick(self.world)
         return TorqueCommands(pick(self.received_ns), pick(self.torques), world,
                               pick(self.stamps_ns), pick(self.forces))
+
+
+class DipoleCommands(TorqueCommands):
+    """
+    N magnetorquer commands, oldest first (kind ``'dipole'``): dipoles (A m^2, body frame).
+
+    As :class:`TorqueCommands` in the body frame without forces: ``received_ns``,
+    ``torques`` (here the (N, 3) dipoles), ``stamps_ns``. The body clips each axis
+    to its ``magnetorquer_max_dipole`` and refuses non-finite ones.
+    """
+
+    kind = 'dipole'
+    __slots__ = ()
+
+    def __init__(self, received_ns, dipoles, stamps_ns=None):
+        super().__init__(received_ns, dipoles, False, stamps_ns)
+
+    @classmethod
+    def one(cls, dipole, received_ns, stamp_ns=None):
+        """Return a single command: ``dipole`` (3,) A m^2, body frame."""
+        return cls((int(received_ns),), (dipole,), None if stamp_ns is None else (int(stamp_ns),))
+
+    def select(self, keep):
+        """Return the commands where the boolean sequence ``keep`` is true, in order."""
+        index = [i for i, k in enumerate(keep) if k]
+        return DipoleCommands([self.received_ns[i] for i in index],
+                              [self.torques[i] for i in index],
+                              None if self.stamps_ns is None else
+                              [self.stamps_ns[i] for i in index])
 
 
 class Mailbox:

@@ -27,8 +27,15 @@ from .pacer import Pace, PAUSED_WAIT
 _NS = 1_000_000_000
 #: Period (wall s) at which the state at t_0 is published again until the first command.
 REPEAT = 1.0
+#: The command topic of each kind of answer, for the log.
+TOPICS = {'torque': 'torque_cmd', 'dipole': 'magnetorquer_cmd', 'wheels': 'wheel_cmd'}
 #: Longest single wait inside due() (s), so that stopping the thread is prompt.
 WAIT_SLICE = 0.1
+
+
+def _at_or_after(stamp_ns, tick_ns):
+    """Whether a held command's stamp (int ns, or None without one) answers the tick."""
+    return stamp_ns is not None and stamp_ns >= tick_ns
 
 
 class Lockstep(Pace):
@@ -36,7 +43,8 @@ class Lockstep(Pace):
     Lockstep schedule of one body: ``control_every`` steps per tick, ``timeout`` (s).
 
     ``answer``: the kinds of command a tick waits for, all of them: 'torque' (a
-    torque_cmd stamped at or after the tick) and/or 'wheels' (a valid wheel command
+    torque_cmd stamped at or after the tick), 'dipole' (a magnetorquer_cmd stamped
+    at or after the tick) and/or 'wheels' (a valid wheel command
     that came during the tick's wait: Float64MultiArray has no stamp); default
     'wheels' for a body with wheels, else 'torque'.
 
@@ -55,8 +63,10 @@ class Lockstep(Pace):
         # the tick, a valid wheel command that came during its wait
         self.answer = frozenset(answer or (('wheels',) if body.wheels is not None
                                            else ('torque',)))
-        if not self.answer <= {'torque', 'wheels'}:
-            raise ValueError(f'answer must be made of torque and wheels, got {answer!r}')
+        if not self.answer <= {'torque', 'wheels', 'dipole'}:
+            raise ValueError(f'answer must be made of torque, dipole and wheels, got {answer!r}')
+        self._stamped = tuple(self.answer & {'torque', 'dipole'})
+        self._awaited = ' and '.join(TOPICS[kind] for kind in sorted(self.answer))
         self.control_every = int(control_every)
         if self.control_every < 1:
             raise ValueError(f'control_every must be >= 1, got {control_every!r}')
@@ -91,7 +101,7 @@ class Lockstep(Pace):
             if value.stamps_ns is not None:
                 fresh = [s >= now for s in value.stamps_ns]
                 if not all(fresh):
-                    body.reject('stale', fresh.count(False))
+                    body.reject('stale', fresh.count(False), value.kind)
                     value = value.select(fresh)
             if len(value):
                 checked = body.check(value)
@@ -113,11 +123,9 @@ class Lockstep(Pace):
                 return PAUSED_WAIT
             now = self.clock()
             self._hold_all()
-            cmd = body.command_held
-            torque = cmd is not None and cmd.stamp_ns is not None and \
-                cmd.stamp_ns >= body.stamp_now()
-            answered = ('torque' not in self.answer or torque) and \
-                ('wheels' not in self.answer or self._wheel_answer)
+            tick = body.stamp_now()
+            answered = all(_at_or_after(body.held_stamp(kind), tick) for kind in self._stamped) \
+                and ('wheels' not in self.answer or self._wheel_answer)
             waited = now - self._wait_start
             if answered or (not self._first and self.timeout_ns and waited > self.timeout_ns):
                 self._close_tick(answered, waited)
@@ -152,7 +160,7 @@ class Lockstep(Pace):
         self.misses += 1
         if not self._streak:
             body.note(
-                f'lockstep: no torque_cmd stamped at or after t = {body.steps * body.dt:.6g} s '
+                f'lockstep: no {self._awaited} for the tick at t = {body.steps * body.dt:.6g} s '
                 f'within {self.timeout_ns / _NS:g} s; holding the last command and going on '
                 '(said once until the controller answers again)')
         self._streak += 1

@@ -127,8 +127,7 @@ class Pace:
     @property
     def wake_steps(self):
         """Return the steps from one wake to the next in real time: a tick, or COMMAND_LOOK."""
-        body = self.body
-        return min(body.publish_every, body.imu_every or body.publish_every, self._look_steps())
+        return min(self.body.shortest_tick, self._look_steps())
 
     def _look_steps(self):
         """Return the steps in COMMAND_LOOK s of wall time (at least 1)."""
@@ -265,11 +264,7 @@ class Pace:
     def _next_target(self):
         """Return the step the next wake is for: the next that publishes, or COMMAND_LOOK s on."""
         body = self.body
-        steps = body.steps
-        ahead = body.publish_every - steps % body.publish_every
-        if body.imu_every:
-            ahead = min(ahead, body.imu_every - steps % body.imu_every)
-        self._target = steps + min(ahead, self._look_steps())
+        self._target = body.steps + min(body.steps_to_tick(), self._look_steps())
         return self._target
 
     def achieved(self):

@@ -287,7 +287,7 @@ class GyrostatIntegrator:
             a = rotate_components((-qx, -qy, -qz, qw), torque_world)
             tx, ty, tz = tx + a[0], ty + a[1], tz + a[2]
         if field is not None:
-            f = field(t, qx, qy, qz, qw)
+            f = field(t, qx, qy, qz, qw, w1, w2, w3)
             tx, ty, tz = tx + f[0], ty + f[1], tz + f[2]
         i1, i2, i3 = self.moments
         hx, hy, hz = i1 * w1, i2 * w2, i3 * w3
@@ -323,7 +323,7 @@ class GyrostatIntegrator:
         Advance by dt, the motor command limited now and held over the step.
 
         ``torque``: external body torque (N m, principal frame), held;
-        ``torque_world``: held in the world frame; ``field(t, qx, qy, qz, qw)``: a
+        ``torque_world``: held in the world frame; ``field(t, qx, qy, qz, qw, wx, wy, wz)``: a
         principal-frame torque evaluated at the stages.
         """
         torque = tuple(float(c) for c in torque)

@@ -163,10 +163,11 @@ class Integrator(ABC):
         Advance by one step dt, the torque held in the body frame over it (N m).
 
         ``torque_world`` (N m), if not None, is held fixed in the world frame.
-        ``field``, if not None, adds a torque that depends on time and attitude,
-        ``field(t, qx, qy, qz, qw)`` -> principal-frame torque (N m) with t the
-        simulated time (s) and q principal -> world: the method evaluates it at
-        its stages (e.g. :class:`~rigid_body_dynamics.physics.disturbances.GravityGradient`).
+        ``field``, if not None, adds a torque that depends on time and state,
+        ``field(t, qx, qy, qz, qw, wx, wy, wz)`` -> principal-frame torque (N m) with t
+        the integrator's time (s), q principal -> world and omega (rad/s,
+        principal): the method evaluates it at its stages (e.g.
+        :class:`~rigid_body_dynamics.physics.environment.SpaceEnvironment`).
         A torque that is not three finite numbers raises ValueError and
         leaves the state as it was.
         """
@@ -360,7 +361,7 @@ class ExactIntegrator(Integrator):
     def _field_step(self, torque, torque_world, field):
         self._segment = None
         t = self.time
-        f = field(t, *self.q)
+        f = field(t, *self.q, *self.omega)
         largest = (max(abs(torque[0] + f[0]), abs(torque[1] + f[1]), abs(torque[2] + f[2]))
                    + max(abs(torque_world[0]), abs(torque_world[1]), abs(torque_world[2])))
         return self._rk('field', torque, torque_world, math.sqrt(largest / self._i_min),

@@ -28,9 +28,10 @@ fixed in the world frame (rotated into the body at every stage). It returns
 by the method's own quadrature of the stage values, so it is accurate to the
 method's order. Four variants: ``free`` (no torque; work 0), ``body`` (tau
 only), ``world`` (tau plus tau_world) and ``field`` (tau plus tau_world plus
-a torque that depends on time and attitude, ``field(t_stage, qx, qy, qz, qw)``
--> body torque (N m), evaluated at every stage at t_stage = t + c_i h, so a
-gravity-gradient torque is integrated to the method's order, not held).
+a torque that depends on time and state, ``field(t_stage, qx, qy, qz, qw, wx, wy,
+wz)`` -> body torque (N m), evaluated at every stage at t_stage = t + c_i h, so a
+gravity-gradient or magnetic torque is integrated to the method's order, not
+held; :class:`~.environment.SpaceEnvironment` is one).
 """
 
 from fractions import Fraction as F
@@ -72,7 +73,8 @@ def _derivative_lines(i, mode, node):
     fx, fy, fz = (' + fx', ' + fy', ' + fz') if mode == 'field' else ('', '', '')
     lines = []
     if mode == 'field':
-        lines.append(f'    fx, fy, fz = field(t + {_lit(node)} * h, {qx}, {qy}, {qz}, {qw})')
+        lines.append(f'    fx, fy, fz = field(t + {_lit(node)} * h, {qx}, {qy}, {qz}, {qw}, '
+                     f'{wx}, {wy}, {wz})')
     if mode in ('world', 'field'):
         # tau_b = tau + R(q)^T tau_world: rotate by the conjugate (-qx, -qy, -qz, qw)
         lines += [

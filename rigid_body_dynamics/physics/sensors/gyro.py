@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from . import quaternions
+from .. import quaternions
 
 
 @dataclass(frozen=True)

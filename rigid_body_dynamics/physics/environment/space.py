@@ -1,0 +1,103 @@
+"""
+The space environment of one body: orbit, magnetic field and the torque models they drive.
+
+:class:`SpaceEnvironment` is what the integrators call at every stage (their
+``field`` argument): at simulated time t it finds the position on the orbit
+and the magnetic field there, turns both into the principal frame of the body's
+attitude at that stage, and sums the torques of its models
+(:mod:`.torque_models`). It knows no model by name.
+"""
+
+
+class Surroundings:
+    """
+    What the models share at one stage: ``r_body`` (m) and ``b_body`` (T), principal frame.
+
+    Also ``r_world`` (m) and ``b_world`` (T); None where the environment has no orbit or
+    no field.
+    """
+
+    __slots__ = ('r_world', 'r_body', 'b_world', 'b_body')
+
+    def __init__(self):
+        self.r_world = self.r_body = self.b_world = self.b_body = None
+
+
+def _to_body(qx, qy, qz, qw, v):
+    """Rotate world vector v by the conjugate of q (q need not be unit): R(q)^T v."""
+    gx, gy, gz = v
+    s = 1.0 / (qx * qx + qy * qy + qz * qz + qw * qw)
+    ux = 2.0 * (-qy * gz + qz * gy)
+    uy = 2.0 * (-qz * gx + qx * gz)
+    uz = 2.0 * (-qx * gy + qy * gx)
+    return (gx + s * (qw * ux - qy * uz + qz * uy),
+            gy + s * (qw * uy - qz * ux + qx * uz),
+            gz + s * (qw * uz - qx * uy + qy * ux))
+
+
+class SpaceEnvironment:
+    """
+    Orbit, field and torque models of one body, as the integrators' stage torque.
+
+    ``orbit`` (a :class:`~.orbit.KeplerOrbit` or None), ``field`` (a
+    :class:`~.magnetic_field.DipoleField` or None), ``models`` (objects on the
+    protocol of :mod:`.torque_models`). ``epoch`` (s) is added to the
+    integrator's time (the simulated time at the integrator's time 0).
+    A model that needs the position without an orbit, or the field without one,
+    is refused with ValueError.
+
+    Called as ``env(t, qx, qy, qz, qw, wx, wy, wz)`` (t in s, q principal ->
+    world, omega rad/s principal) it returns the summed torque (N m, principal).
+    """
+
+    def __init__(self, orbit=None, field=None, models=(), epoch=0.0):
+        self.orbit, self.field, self.models = orbit, field, tuple(models)
+        needs = set()
+        for model in self.models:
+            needs |= model.needs
+        if field is not None:
+            needs.add('field')
+        if 'field' in needs:
+            if field is None:
+                raise ValueError('a magnetic torque needs a magnetic field model '
+                                 '(magnetic_field_model dipole)')
+            needs.add('position')
+        if 'position' in needs and orbit is None:
+            raise ValueError('the gravity gradient and the magnetic field need an orbit '
+                             '(orbit_elements)')
+        self._position = 'position' in needs
+        self._field = 'field' in needs and field is not None
+        self.epoch = float(epoch)
+        self.env = Surroundings()
+
+    def moved(self, epoch):
+        """Return the same environment whose integrator time 0 is simulated time ``epoch``."""
+        return SpaceEnvironment(self.orbit, self.field, self.models, epoch)
+
+    def surroundings(self, t, q):
+        """Fill and return the :class:`Surroundings` at simulated time t (s) and attitude q."""
+        env = self.env
+        if self._position:
+            env.r_world = r = self.orbit.position(t)
+            env.r_body = _to_body(*q, r)
+            if self._field:
+                env.b_world = b = self.field.world(t, r)
+                env.b_body = _to_body(*q, b)
+        return env
+
+    def __call__(self, t, qx, qy, qz, qw, wx=0.0, wy=0.0, wz=0.0):
+        """Return the summed torque (N m, principal frame) at integrator time t (s)."""
+        t = t + self.epoch
+        q = (qx, qy, qz, qw)
+        env = self.surroundings(t, q)
+        r, omega = env.r_world, (wx, wy, wz)
+        tx = ty = tz = 0.0
+        for model in self.models:
+            a, b, c = model.torque(t, r, q, omega, env)
+            tx, ty, tz = tx + a, ty + b, tz + c
+        return tx, ty, tz
+
+    @property
+    def active(self):
+        """Whether any torque model acts."""
+        return bool(self.models)

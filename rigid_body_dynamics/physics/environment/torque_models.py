@@ -1,0 +1,94 @@
+"""
+Torque models: one protocol, evaluated at every stage of the integrator (no ROS).
+
+A torque model is an object with
+
+    torque(t, r, q, omega, env) -> (tx, ty, tz)
+
+returning the torque (N m) in the principal frame of the body's inertia (the
+frame the integrators keep their state in) at simulated time t (s), position r
+(m, world frame; None without an orbit), attitude q (x, y, z, w, principal ->
+world; at RK stages q need not be exactly unit), angular velocity omega (rad/s,
+principal frame), and ``env`` the quantities several models share at that
+stage, computed once by :class:`~.space.SpaceEnvironment`: ``env.r_body`` (the
+position in the principal frame, m) and ``env.b_body`` (the magnetic field in
+the principal frame, T). A model says which of them it reads in ``needs``
+(a set of 'position', 'field'). Its vectors are given in the principal frame
+when it is built (``Inertia.to_principal`` turns a body-frame vector).
+
+Adding a model is one class here (or in a file of its own) and one entry in
+the simulator's parameter table: :class:`~.space.SpaceEnvironment` sums
+whatever models it is given and knows none by name (as Basilisk's hub sums its
+dynamic effectors).
+
+The commanded torque and the constant disturbances are held over a step (a
+zero-order hold), so the integrators take them as their held body and world
+torques, not through this protocol (see ``integrators``); the models here are
+those that change within a step.
+"""
+
+import math
+
+
+class GravityGradient:
+    """
+    The gravity-gradient torque 3 mu / |r|^5 (r_B x I r_B) of a point-mass planet.
+
+    ``moments`` (principal, kg m^2), ``mu`` (m^3/s^2). r_B is the position in the
+    principal frame (Wie, Space Vehicle Dynamics and Control, section 6.3;
+    Basilisk's GravityGradientEffector). Zero when a principal axis points at
+    the planet.
+    """
+
+    needs = frozenset({'position'})
+
+    def __init__(self, moments, mu):
+        self.moments = tuple(float(i) for i in moments)
+        self.mu = float(mu)
+
+    def torque(self, t, r, q, omega, env):
+        """Return 3 mu / |r|^5 (r_B x I r_B) (N m, principal frame)."""
+        rx, ry, rz = env.r_body
+        r2 = rx * rx + ry * ry + rz * rz
+        k = 3.0 * self.mu / (r2 * r2 * math.sqrt(r2))
+        i1, i2, i3 = self.moments
+        return (k * (i3 - i2) * ry * rz, k * (i1 - i3) * rz * rx, k * (i2 - i1) * rx * ry)
+
+
+class MagneticDipole:
+    """
+    The torque m x B of a magnetic dipole m fixed in the body, in the planet's field.
+
+    ``dipole`` (A m^2, principal frame). The residual dipole of a spacecraft
+    (``residual_dipole``) is one; the magnetorquers are another, whose dipole
+    the commands change (:class:`Magnetorquers`).
+    """
+
+    needs = frozenset({'field'})
+
+    def __init__(self, dipole):
+        self.dipole = tuple(float(c) for c in dipole)
+
+    def torque(self, t, r, q, omega, env):
+        """Return m x B_body (N m, principal frame)."""
+        mx, my, mz = self.dipole
+        bx, by, bz = env.b_body
+        return (my * bz - mz * by, mz * bx - mx * bz, mx * by - my * bx)
+
+
+class Magnetorquers(MagneticDipole):
+    """
+    Three magnetic torque rods along the body axes: the commanded dipole m, torque m x B.
+
+    The dipole is held over the step (``set_dipole``, principal frame, A m^2,
+    already within ``magnetorquer_max_dipole``: the engine clips it per body axis
+    when the command arrives); its torque changes within the step as B does.
+    Basilisk's MtbEffector computes the same tau = -[B x] G m.
+    """
+
+    def __init__(self):
+        super().__init__((0.0, 0.0, 0.0))
+
+    def set_dipole(self, dipole):
+        """Hold ``dipole`` (A m^2, principal frame) from the next step on."""
+        self.dipole = dipole

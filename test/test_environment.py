@@ -1,0 +1,272 @@
+"""
+The space environment (physics/environment) against closed forms and an independent DOP853.
+
+The Kepler orbit against the two-body ODE and the conic's invariants, the LVLH
+frame, the dipole field against its formula in the Earth-fixed frame, the
+torque models against numpy, the whole model (orbit, gravity gradient, field,
+residual dipole, magnetorquer commands held) through the engine against
+physics.reference's DOP853 of the same physics written apart, and the
+gravity-gradient pitch libration against its theory.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from rigid_body_dynamics.engine import BodySimulation, Disturbances
+from rigid_body_dynamics.engine.commands import DipoleCommands
+from rigid_body_dynamics.physics import estimators, Inertia, make_integrator, quaternions
+from rigid_body_dynamics.physics.environment import (
+    circular_elements, DipoleField, GravityGradient, KeplerOrbit, lvlh_axes, lvlh_quaternion,
+    MagneticDipole, MU_EARTH, SpaceEnvironment)
+from rigid_body_dynamics.physics.reference import space_zoh_reference
+from scipy.integrate import solve_ivp
+from scipy.spatial.transform import Rotation
+
+ELEMENTS = (7.5e6, 0.1, 1.0, 0.5, 0.3, 0.2)       # a 1.8 h orbit, perigee 373 km up
+
+
+def test_kepler_orbit_against_the_two_body_ode_over_ten_orbits():
+    """Position within 1e-9 of |r| of a DOP853 of r'' = -mu r / |r|^3 over ten orbits."""
+    orbit = KeplerOrbit(ELEMENTS)
+    r0, v0 = orbit.state(0.0)
+    times = np.linspace(0.0, 10 * orbit.period, 41)
+    sol = solve_ivp(lambda _t, y: np.r_[y[3:], -MU_EARTH * y[:3] / np.linalg.norm(y[:3]) ** 3],
+                    (0.0, times[-1]), np.r_[r0, v0], method='DOP853', t_eval=times,
+                    rtol=1e-13, atol=1e-7)
+    worst = max(np.linalg.norm(np.subtract(orbit.position(t), sol.y[:3, k])) / np.linalg.norm(
+        sol.y[:3, k]) for k, t in enumerate(times))
+    assert worst < 1e-9
+    # after a whole number of periods the orbit is back, to round-off
+    np.testing.assert_allclose(orbit.state(10 * orbit.period)[0], r0, rtol=0, atol=1e-8 * 7.5e6)
+
+
+def test_kepler_orbit_keeps_the_conic_and_its_invariants_at_any_time(rng):
+    """|r| = p / (1 + e cos nu), energy -mu / 2a, h = sqrt(mu p) along the normal, to 1e-14."""
+    orbit = KeplerOrbit(ELEMENTS)
+    a, e = ELEMENTS[:2]
+    p = a * (1 - e * e)
+    normal = Rotation.from_euler('ZXZ', [ELEMENTS[3], ELEMENTS[2], ELEMENTS[4]]).apply(
+        [0.0, 0.0, 1.0])
+    for t in rng.uniform(0.0, 1e7, 50):
+        r, v = np.array(orbit.state(t)[0]), np.array(orbit.state(t)[1])
+        rn = np.linalg.norm(r)
+        assert (0.5 * v @ v - MU_EARTH / rn) == pytest.approx(-MU_EARTH / (2 * a), rel=1e-13)
+        np.testing.assert_allclose(np.cross(r, v), math.sqrt(MU_EARTH * p) * normal, rtol=0,
+                                   atol=1e-13 * math.sqrt(MU_EARTH * p))
+        big = orbit.eccentric_anomaly(t)
+        nu = 2 * math.atan2(math.sqrt(1 + e) * math.sin(big / 2),
+                            math.sqrt(1 - e) * math.cos(big / 2))
+        assert rn == pytest.approx(p / (1 + e * math.cos(nu)), rel=1e-14)
+    # the elements at t = 0: the true anomaly nu0 in the perifocal frame, turned by scipy
+    nu0 = ELEMENTS[5]
+    perifocal = p / (1 + e * math.cos(nu0)) * np.array([math.cos(nu0), math.sin(nu0), 0.0])
+    turn = Rotation.from_euler('ZXZ', [ELEMENTS[3], ELEMENTS[2], ELEMENTS[4]])
+    np.testing.assert_allclose(orbit.position(0.0), turn.apply(perifocal), rtol=0, atol=1e-8)
+
+
+def test_a_circular_orbit_turns_at_its_mean_motion():
+    orbit = KeplerOrbit(circular_elements(500e3, inclination=math.pi / 2))
+    n = math.sqrt(MU_EARTH / orbit.a ** 3)
+    r0 = np.array(orbit.position(0.0))
+    r1 = np.array(orbit.position(0.25 * 2 * math.pi / n))
+    assert r0 @ r1 == pytest.approx(0.0, abs=1e-8 * orbit.a ** 2)
+    assert np.linalg.norm(r1) == pytest.approx(orbit.a, rel=1e-15)
+    assert r1[2] == pytest.approx(orbit.a, rel=1e-14)        # polar: over the pole
+
+
+@pytest.mark.parametrize('elements, mu, match', [
+    ((7e6, 1.0, 0, 0, 0, 0), MU_EARTH, 'eccentricity'),
+    ((7e6, -0.1, 0, 0, 0, 0), MU_EARTH, 'eccentricity'),
+    ((-7e6, 0.1, 0, 0, 0, 0), MU_EARTH, 'semi-major axis'),
+    ((6.5e6, 0.1, 0, 0, 0, 0), MU_EARTH, 'perigee radius'),
+    ((7e6, 0.0, float('nan'), 0, 0, 0), MU_EARTH, 'six finite numbers'),
+    ((7e6, 0.0, 0, 0, 0), MU_EARTH, 'six finite numbers'),
+    ((7e6, 0.0, 0, 0, 0, 0), 0.0, 'orbit_mu'),
+])
+def test_bad_orbits_are_refused_naming_the_parameter(elements, mu, match):
+    with pytest.raises(ValueError, match=match):
+        KeplerOrbit(elements, mu=mu)
+
+
+def test_lvlh_axes_and_quaternion(rng):
+    orbit = KeplerOrbit(ELEMENTS)
+    for t in rng.uniform(0.0, 1e5, 20):
+        r, v = orbit.state(t)
+        x, y, z = (np.array(a) for a in lvlh_axes(r, v))
+        np.testing.assert_allclose(np.c_[x, y, z].T @ np.c_[x, y, z], np.eye(3), atol=1e-15)
+        np.testing.assert_allclose(z, -np.array(r) / np.linalg.norm(r), atol=1e-15)
+        np.testing.assert_allclose(np.cross(x, y), z, atol=1e-15)
+        assert np.dot(y, orbit.normal) == pytest.approx(-1.0, abs=1e-14)
+        q = lvlh_quaternion(r, v)
+        expected = Rotation.from_matrix(np.c_[x, y, z]).as_quat()
+        assert quaternions.angle_between(np.array(q), expected) < 1e-14
+
+
+def test_the_dipole_field_against_its_formula_in_the_earth_fixed_frame(rng):
+    field = DipoleField(rotation_angle=0.7)
+    g10, g11, h11 = -29404.8e-9, -1450.9e-9, 4652.5e-9
+    d = np.array([g11, h11, g10])
+    for _ in range(20):
+        t = rng.uniform(0.0, 1e5)
+        r = rng.normal(size=3) * 7e6
+        to_fixed = Rotation.from_euler('z', -(0.7 + 7.2921150e-5 * t))
+        r_f = to_fixed.apply(r)
+        rn = np.linalg.norm(r_f)
+        b_f = (6371.2e3 / rn) ** 3 * (3 * (d @ r_f) / rn * r_f / rn - d)
+        np.testing.assert_allclose(field.world(t, r), to_fixed.inv().apply(b_f), rtol=0,
+                                   atol=1e-14 * np.linalg.norm(b_f))
+    # on the dipole's axis at the reference radius: B = 2 d; on its equator: -d
+    axis = d / np.linalg.norm(d) * 6371.2e3
+    np.testing.assert_allclose(DipoleField(rotation_angle=0.0).world(0.0, axis), 2 * d,
+                               rtol=1e-14)
+    with pytest.raises(ValueError, match='magnetic_dipole_coefficients'):
+        DipoleField((1.0, float('inf'), 0.0))
+
+
+def test_the_torque_models_against_numpy(rng):
+    moments = (2.0, 3.0, 1.0)
+    orbit, field = KeplerOrbit(ELEMENTS), DipoleField()
+    m = (0.3, -0.1, 0.2)
+    env = SpaceEnvironment(orbit, field, [GravityGradient(moments, MU_EARTH), MagneticDipole(m)])
+    for _ in range(20):
+        q, w, t = rng.normal(size=4), rng.normal(size=3), rng.uniform(0.0, 1e4)
+        rot = Rotation.from_quat(q)
+        r = np.array(orbit.position(t))
+        r_b, b_b = rot.inv().apply(r), rot.inv().apply(field.world(t, r))
+        expected = 3 * MU_EARTH / np.linalg.norm(r) ** 5 * np.cross(r_b, np.diag(moments) @ r_b) \
+            + np.cross(m, b_b)
+        np.testing.assert_allclose(env(t, *(1.3 * q), *w), expected, rtol=0,
+                                   atol=1e-13 * np.linalg.norm(expected))
+    with pytest.raises(ValueError, match='orbit'):
+        SpaceEnvironment(None, None, [GravityGradient(moments, MU_EARTH)])
+    with pytest.raises(ValueError, match='magnetic field'):
+        SpaceEnvironment(orbit, None, [MagneticDipole(m)])
+
+
+MOMENTS = (2.0, 3.0, 1.0)
+BOX = (0.05, 0.02, 0.03)    # magnetorquer limits (A m^2 per body axis) of the whole-model run
+
+
+def _dipole_schedule(k):
+    """A magnetorquer command per 0.1 s (A m^2, body), some over the limits of BOX."""
+    return (0.08 * math.sin(0.7 * k), 0.015 * math.cos(0.3 * k), -0.04 + 0.01 * (k % 5))
+
+
+def _whole_model_run(dt, seconds):
+    """The engine under the whole model and a dipole schedule; returns (body, states, ref)."""
+    orbit, field = KeplerOrbit(ELEMENTS), DipoleField(rotation_angle=0.4)
+    residual = (0.002, -0.001, 0.003)
+    q0, w0 = quaternions.normalize(np.array([0.1, 0.2, -0.3, 0.9])), (0.4, -0.7, 1.1)
+    body = BodySimulation(Inertia(MOMENTS), 'exact', 1.0 / dt, (q0, w0), torque_timeout=0.0,
+                          publish_every=round(0.1 / dt),
+                          disturbances=Disturbances(orbit=orbit, field=field,
+                                                    gravity_gradient=True,
+                                                    residual_dipole=residual),
+                          magnetorquers=BOX)
+    holds, per = round(seconds / 0.1), round(0.1 / dt)
+    outbox = []
+    with body.lock:
+        for k in range(holds):
+            body.hold(body.check(DipoleCommands.one(_dipole_schedule(k), 0)), 0, 1)
+            for _ in range(per):
+                body.advance(0, outbox)
+
+    def clipped(k, _q, _w):
+        return tuple(max(-b, min(b, c)) for c, b in zip(_dipole_schedule(k), BOX))
+    r0, v0 = orbit.state(0.0)
+    ref = space_zoh_reference(MOMENTS, MU_EARTH, r0, v0, q0, w0, 0.1, holds, clipped,
+                              field=field, residual=residual)
+    return body, outbox, ref
+
+
+@pytest.mark.parametrize('dt, seconds', [(0.001, 5.0), (0.01, 50.0)])
+def test_the_whole_model_through_the_engine_against_an_independent_dop853(dt, seconds):
+    """
+    Orbit, gravity gradient, dipole field, residual dipole and held magnetorquer commands.
+
+    A tumbling body (|omega| 1.4 rad/s) for 500 commands of 0.1 s: attitude and omega at
+    every 0.1 s within 1e-12 (rad, and relative) of DOP853 at rtol 2.5e-14, the position
+    within 1e-14 relative (the reference integrates the orbit as an ODE).
+    """
+    body, outbox, (q_ref, w_ref, r_ref) = _whole_model_run(dt, seconds)
+    states = outbox
+    assert len(states) == len(q_ref) - 1
+    worst_q = max(quaternions.angle_between(np.array(s.q_principal), q)
+                  for s, q in zip(states, q_ref[1:]))
+    worst_w = max(np.linalg.norm(np.subtract(s.omega_principal, w)) / np.linalg.norm(w)
+                  for s, w in zip(states, w_ref[1:]))
+    worst_r = max(np.linalg.norm(np.subtract(s.position[0], r)) / np.linalg.norm(r)
+                  for s, r in zip(states, r_ref[1:]))
+    assert worst_q < 1e-12 and worst_w < 1e-12 and worst_r < 1e-14, (worst_q, worst_w, worst_r)
+    # the magnetic torque is not negligible: omega moved by far more than the tolerance
+    assert np.linalg.norm(np.subtract(w_ref[-1], w_ref[0])) > 1e-6
+    # the commands over the limits were clipped per axis and counted, the dipole applied
+    assert body.dipole_counts['clipped'] > 0 and body.dipole_counts['accepted'] == len(q_ref) - 1
+    assert states[-1].dipole == tuple(max(-b, min(b, c)) for c, b in
+                                      zip(_dipole_schedule(len(q_ref) - 2), BOX))
+
+
+def test_magnetorquer_commands_refused_held_and_timed_out():
+    orbit, field = KeplerOrbit(ELEMENTS), DipoleField()
+    body = BodySimulation(Inertia(MOMENTS), 'exact', 1000.0, ((0, 0, 0, 1), (0.1, 0.0, 0.0)),
+                          torque_timeout=0.05, publish_every=10,
+                          disturbances=Disturbances(orbit=orbit, field=field),
+                          magnetorquers=(0.0, 0.0, 0.0))
+    with body.lock:
+        events = body.hold(body.check(DipoleCommands.one((float('nan'), 0.0, 0.0), 0)), 0, 1)
+        assert events == {'dipole_rejected_non_finite'} and body.dipole_held is None
+        body.hold(body.check(DipoleCommands.one((1e3, 0.0, 0.0), 0)), 0, 1)   # 0 = no limit
+        assert body.dipole_held[0] == (1e3, 0.0, 0.0)
+        outbox = []
+        body.advance(10 ** 6, outbox)                  # within the timeout: held
+        assert body._field is not None and body.snapshot().dipole == (1e3, 0.0, 0.0)
+        body.advance(60 * 10 ** 6, outbox)             # 60 ms later: timed out, zero, free
+        assert body.snapshot().dipole == (0.0, 0.0, 0.0) and body._field is None
+        assert any('magnetorquer command timed out' in n for n in body.take_notes())
+    assert body.dipole_counts == {'accepted': 1, 'rejected_non_finite': 1, 'rejected_frame': 0,
+                                  'clipped': 0, 'stale': 0}
+
+
+def test_pitch_libration_frequency_is_n_sqrt_3_ix_minus_iz_over_iy():
+    """
+    Principal axes on LVLH (z nadir, y minus the orbit normal), turning at n, pitched 0.01 rad.
+
+    The pitch angle oscillates at omega_p = n sqrt(3 (Ix - Iz) / Iy) (Wie, section 6.3);
+    the amplitude correction at 0.01 rad is about theta0^2 / 4 = 2.5e-5, so the measured
+    period is within 1e-4 of the small-angle one.
+    """
+    orbit = KeplerOrbit(circular_elements(500e3))
+    n = orbit.n
+    env = SpaceEnvironment(orbit, None, [GravityGradient(MOMENTS, MU_EARTH)])
+    r, v = orbit.state(0.0)
+    lvlh = Rotation.from_quat(lvlh_quaternion(r, v))
+    start = lvlh * Rotation.from_rotvec([0.0, 0.01, 0.0])
+    body = make_integrator('exact', MOMENTS, 1.0, start.as_quat(), (0.0, -n, 0.0))
+    omega_p = n * math.sqrt(3.0 * (MOMENTS[0] - MOMENTS[2]) / MOMENTS[1])
+    steps = int(3.2 * 2 * math.pi / omega_p)
+    t, pitch = np.empty(steps + 1), np.empty(steps + 1)
+    for k in range(steps + 1):
+        r, v = orbit.state(body.time)
+        rel = Rotation.from_quat(lvlh_quaternion(r, v)).inv() * Rotation.from_quat(body.q)
+        t[k], pitch[k] = body.time, rel.as_rotvec()[1]
+        body.step((0.0, 0.0, 0.0), None, env)
+    assert np.max(np.abs(pitch)) == pytest.approx(0.01, rel=1e-3)     # stays librating
+    crossings = estimators.crossing_times(t, pitch, direction=0)
+    period = 2.0 * np.mean(np.diff(crossings))
+    assert period == pytest.approx(2 * math.pi / omega_p, rel=1e-4)
+
+
+def test_rk4_under_the_environment_is_fourth_order():
+    """Halving the step divides rk4's error by 16 (14-18): the torques are not held per step."""
+    orbit = KeplerOrbit((1.0, 0.0, 0.3, 0.0, 0.0, 0.0), mu=0.25, planet_radius=0.0)  # n 0.5
+    env = SpaceEnvironment(orbit, None, [GravityGradient(MOMENTS, 0.25)])
+    q0, w0 = quaternions.normalize(np.array([0.1, 0.2, -0.3, 0.9])), (0.4, -0.7, 1.1)
+
+    def error(dt):
+        exact, rk4 = (make_integrator(name, MOMENTS, dt, q0, w0) for name in ('exact', 'rk4'))
+        for _ in range(round(4.0 / dt)):
+            exact.step((0.0, 0.0, 0.0), None, env)
+            rk4.step((0.0, 0.0, 0.0), None, env)
+        return quaternions.angle_between(np.array(rk4.q), np.array(exact.q))
+    assert 14.0 < error(0.02) / error(0.01) < 18.0
