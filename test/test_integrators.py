@@ -382,4 +382,4 @@ def test_a_traceback_through_a_kernel_shows_the_stage_statement():
     except ZeroDivisionError:
         text = traceback.format_exc()
     assert 'File "<rk kernel order 8 field>", line 10, in step' in text
-    assert 'fx, fy, fz = field(t + 0.0 * h, qx0, qy0, qz0, qw0)' in text
+    assert 'fx, fy, fz = field(t + 0.0 * h, qx0, qy0, qz0, qw0, wx0, wy0, wz0)' in text
