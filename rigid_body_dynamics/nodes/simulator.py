@@ -36,7 +36,7 @@ import sys
 import threading
 
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import WrenchStamped
+from geometry_msgs.msg import Vector3Stamped, WrenchStamped
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
@@ -49,7 +49,7 @@ from .simulator_parameters import PARAMETERS, state_topics
 from ..engine import BodySimulation, Lockstep, Loop, Member, Pace
 from ..physics import presets
 from ..physics.sensors import GyroErrors
-from ..ros.command_decoder import decode_wheels, steady_times, TorqueDecoder
+from ..ros.command_decoder import decode_dipoles, decode_wheels, steady_times, TorqueDecoder
 from ..ros.intake import Intake
 from ..ros.runner import run
 from ..ros.state_publisher import StatePublisher, tf_available
@@ -137,7 +137,14 @@ class AttitudeSimulator(Node):
                             values['gyro_turn_on_bias'], values['gyro_bias_correlation_time'],
                             values['orientation_noise'], values['gyro_resolution']),
             seed=values['noise_seed'], disturbances=values['disturbances'],
-            wheels=values['wheels'], wheel_speeds=values['wheel_speeds'])
+            wheels=values['wheels'], wheel_speeds=values['wheel_speeds'],
+            magnetorquers=values['magnetorquer_max_dipole']
+            if values['disturbances'].field is not None else None,
+            magnetometer=(values['magnetometer_noise'], values['magnetometer_bias'])
+            if values['magnetometer_rate'] > 0.0 else None,
+            magnetometer_every=self._publish_every(values['magnetometer_rate'])
+            if values['magnetometer_rate'] > 0.0 else 0)
+        self._lvlh_frame = values['lvlh_frame']
         self._publish_rate = values['publish_rate']
         self._decoder = TorqueDecoder(self._frames)
         self._refused_frame = ''
@@ -167,8 +174,16 @@ class AttitudeSimulator(Node):
             f'{self._preset.name}: I = {body.moments.tolist()} kg m^2 ({body.kind}), '
             f'omega0 = {list(self.body.initial[1])} rad/s, {self.body.integrator_name} at '
             f'{rate:g} Hz, publishing at {self._publish_rate:g} Hz, {pacing}')
-        if values['disturbances'].active:
-            self.get_logger().info(f'disturbances: {values["disturbances"]}')
+        env = values['disturbances']
+        if env.active:
+            self.get_logger().info(f'disturbances: {env}')
+        if env.orbit is not None:
+            a, e, inc = env.orbit.elements[:3]
+            self.get_logger().info(
+                f'orbit: a = {a:.6g} m, e = {e:g}, i = {inc:g} rad, period '
+                f'{env.orbit.period:.6g} s; magnetic field: '
+                f'{values["magnetic_field_model"]}'
+                + ('; magnetorquers on magnetorquer_cmd' if self.body.max_dipole else ''))
         if self.body.wheels is not None:
             w = self.body.wheels
             self.get_logger().info(
@@ -216,7 +231,10 @@ class AttitudeSimulator(Node):
             self, self._frames, publish_imu=self.get_parameter('publish_imu').value,
             publish_clock=self._publish_clock, publish_tf=publish_tf,
             topics=state_topics(self.get_parameter('state_topics').value),
-            wheels=self.body.wheels.count if self.body.wheels is not None else 0)
+            wheels=self.body.wheels.count if self.body.wheels is not None else 0,
+            orbit=self.body.disturbances.orbit is not None, lvlh_frame=self._lvlh_frame,
+            magnetorquers=self.body.max_dipole is not None,
+            magnetometer=bool(self.body.magnetometer_every))
         if publish_tf and not tf_available():
             self.get_logger().info('publish_tf: tf2_msgs is not importable here (no tf2_msgs '
                                    'wheel exists; on a ROS install it is), so /tf is not '
@@ -231,6 +249,10 @@ class AttitudeSimulator(Node):
         if self.body.wheels is not None:
             self._intake.subscribe(Float64MultiArray, 'wheel_cmd', TORQUE_QOS, overridable=True)
             self._decoders['wheel_cmd'] = decode_wheels
+        if self.body.max_dipole is not None:
+            self._intake.subscribe(Vector3Stamped, 'magnetorquer_cmd', TORQUE_QOS,
+                                   overridable=True)
+            self._decoders['magnetorquer_cmd'] = self._decode_dipoles
         self._commands = tuple(self._decoders)
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
@@ -260,6 +282,13 @@ class AttitudeSimulator(Node):
             self.body.reject('rejected_frame', count)
         return commands
 
+    def _decode_dipoles(self, raws, received_ns):
+        """Decode magnetorquer_cmd messages; those in a frame other than the body's are counted."""
+        commands, refused = decode_dipoles(raws, received_ns, self._decoder.body_frame)
+        if refused:
+            self.body.reject('rejected_frame', refused, 'dipole')
+        return commands
+
     def _warn_events(self, events):
         """Warn (throttled) about the command events the body reported."""
         warn = self._warnings.warn
@@ -279,7 +308,15 @@ class AttitudeSimulator(Node):
         if 'wheel_rejected' in events:
             warn('wheel', f'wheel_cmd rejected: it needs {self.body.wheels.count} finite motor '
                  'torques (N m, one per wheel); state unchanged')
-        if 'stale' in events:
+        if 'dipole_rejected_non_finite' in events:
+            warn('dipole', 'magnetorquer_cmd rejected: non-finite dipole; state unchanged')
+        if 'dipole_rejected_frame' in events:
+            warn('dipole_frame', 'magnetorquer_cmd rejected: its frame_id must be '
+                 f'{self._decoder.body_frame!r} or "" (the rods are fixed in the body)')
+        if 'dipole_clipped' in events:
+            warn('dipole_clipped', 'magnetorquer_cmd clipped to magnetorquer_max_dipole = '
+                 f'{list(self.body.max_dipole)} A m^2 per body axis')
+        if 'stale' in events or 'dipole_stale' in events:
             warn('stale', 'lockstep: torque_cmd stamped before the current tick dropped '
                  '(an answer that came after its tick was missed)')
 

@@ -5,6 +5,8 @@ The /diagnostics of attitude_simulator: two statuses per period, integrator and 
 factor, missed deadlines and lateness, quaternion norm error, drift since the
 last torque, work, and in lockstep the answered and missed ticks and the wait
 per tick. ``torque command``: age, timeout, frame, vector and the counters.
+``magnetorquers`` (with a magnetic field): the dipole applied, the command held, the
+counts of accepted, refused (non-finite, frame), clipped and stale commands;
 ``reaction wheels`` (with wheels): speeds, speed over limit, motor torques applied,
 the held command, clipped and cut-off steps, motor work, friction loss, counters.
 """
@@ -33,6 +35,8 @@ class SimulatorReport:
         out = [self._integrator(name, hardware_id), self._torque(name, hardware_id)]
         if self._health['wheels'] is not None:
             out.append(self._wheels(name, hardware_id))
+        if self._health['magnetorquers'] is not None:
+            out.append(self._magnetorquers(name, hardware_id))
         return out
 
     def _wheels(self, name, hw):
@@ -58,6 +62,23 @@ class SimulatorReport:
             ('motor work since reset (J)', w['motor work']),
             ('friction loss since reset (J)', w['friction loss']),
             ('accepted', counts['accepted']), ('rejected', counts['rejected'])], hw)
+
+    def _magnetorquers(self, name, hw):
+        m = self._health['magnetorquers']
+        counts, held = m['counts'], m['command']
+        if m['timed_out']:
+            level, message = DiagnosticStatus.WARN, 'magnetorquer command timed out: dipole 0'
+        else:
+            level, message = DiagnosticStatus.OK, ('no magnetorquer command received'
+                                                   if held is None else
+                                                   'holding the last magnetorquer command')
+        refused = counts['rejected_non_finite'] + counts['rejected_frame']
+        if refused:
+            message += f'; {refused} rejected'
+        return status(f'{name}: magnetorquers', level, message, [
+            ('dipole applied (A m^2)', list(m['dipole'])),
+            ('command (A m^2)', 'none' if held is None else list(held[0])),
+            ('timed out', m['timed_out'])] + [(key, value) for key, value in counts.items()], hw)
 
     def _integrator(self, name, hw):
         body, pace = self.body, self.pace

@@ -8,10 +8,9 @@ cross-checks below give every refusal its reason.
 
 import math
 
+from .environment_parameters import environment_from, environment_params
 from .wheel_parameters import WHEEL_PARAMS, wheel_params, wheels_from
-from ..engine import Disturbances
 from ..physics import Inertia, INTEGRATORS, presets
-from ..physics.disturbances import GravityGradient
 from ..physics.gyrostat import GyrostatIntegrator
 from ..physics.integrators import REMOVED as REMOVED_INTEGRATORS
 from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
@@ -87,16 +86,8 @@ def _control_steps(values, out):
 
 
 def _disturbances(values, out):
-    """Cross-check: the orbit's frame is valid when the gravity gradient is on."""
-    if out['gravity_gradient_orbit_rate'] > 0.0:
-        try:
-            GravityGradient((1.0, 1.0, 1.0), out['gravity_gradient_orbit_rate'],
-                            out['orbit_normal'], out['orbit_nadir'])
-        except ValueError as err:
-            raise ConfigurationError(str(err).replace('nadir0', 'orbit_nadir')) from None
-    out['disturbances'] = Disturbances(
-        out['disturbance_torque_body'], out['disturbance_torque_world'],
-        out['gravity_gradient_orbit_rate'], out['orbit_normal'], out['orbit_nadir'])
+    """Cross-check: the environment (orbit, field, torque models) as out['disturbances']."""
+    out['disturbances'] = environment_from(out)
 
 
 def _wheels(values, out):
@@ -121,10 +112,14 @@ def _wheels(values, out):
 def _lockstep_answer(values, out):
     """Cross-check: the kinds of command that answer a lockstep tick (out['answer'])."""
     answer = {'auto': None, 'torque_cmd': ('torque',), 'wheel_cmd': ('wheels',),
-              'both': ('torque', 'wheels')}[out['lockstep_answer']]
+              'both': ('torque', 'wheels'),
+              'magnetorquer_cmd': ('dipole',)}[out['lockstep_answer']]
     if answer and 'wheels' in answer and out['wheels'] is None:
         raise ConfigurationError(f'lockstep_answer {out["lockstep_answer"]} needs wheels '
                                  '(wheel_axes)')
+    if answer == ('dipole',) and out['magnetic_field_model'] != 'dipole':
+        raise ConfigurationError('lockstep_answer magnetorquer_cmd needs magnetorquers '
+                                 '(magnetic_field_model dipole)')
     out['answer'] = answer
 
 
@@ -232,10 +227,12 @@ PARAMETERS = ParameterTable([
           low=1e-6, high=1e6, read_only=True),
     Param('lockstep_answer', 'string', 'auto', '`auto`',
           'Lockstep: what answers a tick: torque_cmd (stamped at or after the tick), '
+          'magnetorquer_cmd (likewise), '
           "wheel_cmd (a valid one during the tick's wait; it has no stamp), or both (a "
           'controller that flies the wheels and dumps momentum with torque_cmd); auto = '
           'wheel_cmd with wheels, else torque_cmd.',
-          read_only=True, choices=('auto', 'both', 'torque_cmd', 'wheel_cmd')),
+          read_only=True, choices=('auto', 'both', 'magnetorquer_cmd', 'torque_cmd',
+                                   'wheel_cmd')),
     Param('lockstep_timeout', 'double', 1.0, '1.0 s',
           'Lockstep: after the first command, a tick whose command does not come within this '
           'wall time is a counted, logged miss and the last command is held; 0 = wait for '
@@ -246,15 +243,7 @@ PARAMETERS = ParameterTable([
           'applied_torque).'),
     Param('disturbance_torque_world', 'double[3]', [0.0, 0.0, 0.0], '[0, 0, 0] N m',
           'Constant disturbance torque fixed in the world frame, added to the command.'),
-    Param('gravity_gradient_orbit_rate', 'double', 0.0, '0.0 rad/s',
-          'Orbit rate n of a circular orbit whose gravity-gradient torque 3 n^2 r x (I r) '
-          'acts on the body (r the nadir unit vector in the body frame); 0 = none. '
-          'Low Earth orbit: about 1.1e-3.', low=0.0, high=1e3, read_only=True),
-    Param('orbit_normal', 'double[3]', [0.0, 0.0, 1.0], '[0, 0, 1]',
-          'Orbit normal (world frame): nadir turns about it at n.', read_only=True),
-    Param('orbit_nadir', 'double[3]', [1.0, 0.0, 0.0], '[1, 0, 0]',
-          'Direction from the body to the planet (world frame) at simulated time 0; made '
-          'perpendicular to orbit_normal.', read_only=True),
+    *environment_params(),
     Param('noise_seed', 'int', 0, '0',
           'Seed of the gyro noise: the same seed and parameters give the same imu stream, bit '
           'for bit (also after ~/reset).', low=0, high=2 ** 31 - 1, read_only=True),

@@ -6,18 +6,20 @@ The simulator's integration thread takes the serialised messages pending on
 into one :class:`~rigid_body_dynamics.engine.commands.TorqueCommands`: read in one
 go with :mod:`rigid_body_dynamics.messages.cdr` when they share a frame id (a flood costs
 little), else deserialised one by one; :func:`decode_wheels` turns ``wheel_cmd``
-(std_msgs/Float64MultiArray) into :class:`~rigid_body_dynamics.engine.commands.WheelCommands`.
+(std_msgs/Float64MultiArray) into :class:`~rigid_body_dynamics.engine.commands.WheelCommands`
+and :func:`decode_dipoles` ``magnetorquer_cmd`` into
+:class:`~rigid_body_dynamics.engine.commands.DipoleCommands`.
 Everything after that (checks, counts, the held command, its timing) is the engine's.
 """
 
 import time
 
-from geometry_msgs.msg import WrenchStamped
+from geometry_msgs.msg import Vector3Stamped, WrenchStamped
 from rclpy.serialization import deserialize_message
 from std_msgs.msg import Float64MultiArray
 
 from . import conversions as conv
-from ..engine.commands import TorqueCommands, WheelCommands
+from ..engine.commands import DipoleCommands, TorqueCommands, WheelCommands
 from ..messages import cdr
 
 
@@ -82,6 +84,25 @@ class TorqueDecoder:
             [k[0] for k in kept], [conv.vector_array(k[1].wrench.torque) for k in kept],
             [k[2] for k in kept], [conv.time_ns(k[1].header.stamp) for k in kept],
             [conv.vector_array(k[1].wrench.force) for k in kept]), refused
+
+
+def decode_dipoles(raws, received_ns, body_frame):
+    """
+    Return (DipoleCommands, refused count) of serialised geometry_msgs/Vector3Stamped ``raws``.
+
+    A magnetorquer command's frame_id must be ``body_frame`` or "" (the rods are
+    fixed in the body); any other is refused and counted. ``received_ns``: steady
+    receive times (int ns), oldest first.
+    """
+    kept, refused = [], 0
+    for raw, at in zip(raws, received_ns):
+        msg = deserialize_message(raw, Vector3Stamped)
+        if msg.header.frame_id not in ('', body_frame):
+            refused += 1
+            continue
+        kept.append((at, conv.vector_array(msg.vector).tolist(), conv.time_ns(msg.header.stamp)))
+    return DipoleCommands([k[0] for k in kept], [k[1] for k in kept],
+                          [k[2] for k in kept]), refused
 
 
 def decode_wheels(raws, received_ns):

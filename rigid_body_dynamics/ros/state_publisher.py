@@ -5,10 +5,14 @@ Like tf2_ros' ``TransformBroadcaster(node)``: the node keeps its parameters,
 subscriptions and services; this object owns the publishers of ``odom``,
 ``orientation``, ``angular_velocity``, ``angular_momentum``,
 ``angular_momentum_body``, ``applied_torque``, ``imu`` and ``~/imu_bias``
-(optional; from the engine's gyro samples), the latched
+(optional; from the engine's gyro samples), ``magnetic_field`` (the
+magnetometer's samples), ``applied_dipole`` (with magnetorquers), the latched
 ``inertia``, ``/clock`` (optional) and ``/tf`` (optional: world -> body
-frame, when tf2_msgs is importable, as on every ROS install), and turns an engine
-:class:`~rigid_body_dynamics.engine.body.Snapshot` into their messages. All
+frame, and world -> LVLH with an orbit, when tf2_msgs is importable, as on every
+ROS install), and turns each engine item (a
+:class:`~rigid_body_dynamics.engine.body.Snapshot`, a sensor sample) into its
+messages, dispatching by the item's type from one table. With an orbit, odom
+carries the position (world) and the linear velocity (body frame). All
 messages of one tick carry the snapshot's stamp; vectors are published in the
 user's body frame (``body_frame``) or the world frame (``world_frame``).
 The messages of the state topics are :class:`~.prepacked.Prepacked`: serialised
@@ -23,12 +27,13 @@ import numpy as np
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions
 from rosgraph_msgs.msg import Clock as ClockMsg
-from sensor_msgs.msg import Imu, JointState
+from sensor_msgs.msg import Imu, JointState, MagneticField
 
 from . import conversions as conv
 from .prepacked import Prepacked
-from ..engine import ImuSample
+from ..engine import ImuSample, MagneticSample, Snapshot
 from ..physics import quaternions
+from ..physics.environment import lvlh_quaternion
 
 try:
     from tf2_msgs.msg import TFMessage
@@ -63,12 +68,19 @@ class StatePublisher:
     """
     The state publishers of one body on ``node``: ``frames`` = (world, body) frame ids.
 
-    ``topics``: which of OPTIONAL_TOPICS to publish besides odom (default all).
+    ``topics``: which of OPTIONAL_TOPICS to publish besides odom (default all);
+    ``orbit``: the body has an orbit (odom's position and linear velocity, the
+    LVLH frame ``lvlh_frame`` on /tf); ``magnetorquers``: publish
+    ``applied_dipole``; ``magnetometer``: publish ``magnetic_field``.
     """
 
     def __init__(self, node, frames, publish_imu=True, publish_clock=False, publish_tf=False,
-                 topics=OPTIONAL_TOPICS, wheels=0):
+                 topics=OPTIONAL_TOPICS, wheels=0, orbit=False, lvlh_frame='lvlh',
+                 magnetorquers=False, magnetometer=False):
         self.world_frame, self.body_frame = frames
+        self._handlers = {Snapshot: self._publish_state, ImuSample: self.publish_imu,
+                          MagneticSample: self.publish_magnetic}
+        self._orbit = orbit
         qos_opts = QoSOverridingOptions.with_default_policies()
 
         def pub(msg_type, name, qos=STATE_QOS):
@@ -80,7 +92,8 @@ class StatePublisher:
         odom.header.frame_id, odom.child_frame_id = frames
         self._odom = pub(Odometry, 'odom')
         self._odom_bytes = Prepacked(odom, ('header.stamp', 'pose.pose.orientation',
-                                            'twist.twist.angular'))
+                                            'twist.twist.angular') + (
+            ('pose.pose.position', 'twist.twist.linear') if orbit else ()))
         # each message is prepacked only for a publisher that exists (two serialisations each)
         self._orientation = pub(QuaternionStamped, 'orientation')
         if self._orientation is not None:
@@ -104,6 +117,15 @@ class StatePublisher:
                                               'orientation_covariance',
                                               'angular_velocity_covariance'))
             self._bias_bytes = _stamped(Vector3Stamped(), body, 'vector')
+        self._dipole = pub(Vector3Stamped, 'applied_dipole') if magnetorquers else None
+        if magnetorquers:
+            self._dipole_bytes = _stamped(Vector3Stamped(), body, 'vector')
+        self._magnetic = pub(MagneticField, 'magnetic_field') if magnetometer else None
+        if magnetometer:
+            magnetic = MagneticField()
+            magnetic.header.frame_id = body
+            self._magnetic_bytes = Prepacked(magnetic, ('header.stamp', 'magnetic_field',
+                                                        'magnetic_field_covariance'))
         self._inertia = pub(InertiaStamped, 'inertia', LATCHED_QOS)
         self._wheel_state = pub(JointState, 'wheel_state') if wheels else None
         if wheels:
@@ -117,21 +139,35 @@ class StatePublisher:
         if self._tf is not None:
             tf = TransformStamped()
             tf.header.frame_id, tf.child_frame_id = frames
-            self._tf_bytes = Prepacked(TFMessage(transforms=[tf]), (
-                'transforms.0.header.stamp', 'transforms.0.transform.rotation'))
+            transforms, fields = [tf], ['transforms.0.header.stamp',
+                                        'transforms.0.transform.rotation']
+            if orbit:
+                lvlh = TransformStamped()
+                lvlh.header.frame_id, lvlh.child_frame_id = world, lvlh_frame
+                transforms.append(lvlh)
+                fields += ['transforms.0.transform.translation', 'transforms.1.header.stamp',
+                           'transforms.1.transform.translation',
+                           'transforms.1.transform.rotation']
+            self._tf_bytes = Prepacked(TFMessage(transforms=transforms), tuple(fields))
 
-    def publish(self, snapshot):
-        """Publish one engine item: a Snapshot's state topics, or an ImuSample's imu and bias."""
-        if isinstance(snapshot, ImuSample):
-            self.publish_imu(snapshot)
-            return
+    def publish(self, item):
+        """Publish one engine item (a Snapshot, an ImuSample, a MagneticSample): its topics."""
+        self._handlers[type(item)](item)
+
+    def _publish_state(self, snapshot):
+        """Publish a Snapshot's state topics."""
         inertia = snapshot.inertia
         q_b, w_b = snapshot.q_principal, snapshot.omega_principal
         if not inertia.is_principal_frame:
             q_b = inertia.attitude_to_body(np.array(q_b))
             w_b = inertia.to_body(np.array(w_b))
         stamp = snapshot.stamp_ns
-        self._odom.publish(self._odom_bytes.pack(stamp, q_b, w_b))
+        if self._orbit:
+            r, v = snapshot.position
+            v_b = quaternions.rotate_components((-q_b[0], -q_b[1], -q_b[2], q_b[3]), v)
+            self._odom.publish(self._odom_bytes.pack(stamp, q_b, w_b, r, v_b))
+        else:
+            self._odom.publish(self._odom_bytes.pack(stamp, q_b, w_b))
         if snapshot.wheels is not None and self._wheel_state is not None:
             # with odom at every tick (lockstep's too): a controller needs the wheel speeds
             joints, wheels = self._joints, snapshot.wheels
@@ -144,7 +180,12 @@ class StatePublisher:
         if self._clock is not None:
             self._clock.publish(self._clock_bytes.pack(stamp))
         if self._tf is not None:
-            self._tf.publish(self._tf_bytes.pack(stamp, q_b))
+            if self._orbit:
+                r, v = snapshot.position
+                self._tf.publish(self._tf_bytes.pack(stamp, q_b, r, stamp, r,
+                                                     lvlh_quaternion(r, v)))
+            else:
+                self._tf.publish(self._tf_bytes.pack(stamp, q_b))
 
     def _publish_others(self, snapshot, stamp, q_b, w_b):
         """Publish the optional state topics of one tick (those this publisher has)."""
@@ -166,6 +207,8 @@ class StatePublisher:
             torque = snapshot.torque_principal if inertia.is_principal_frame else \
                 inertia.to_body(np.array(snapshot.torque_principal))
             self._torque.publish(self._torque_bytes.pack(stamp, torque))
+        if self._dipole is not None:
+            self._dipole.publish(self._dipole_bytes.pack(stamp, snapshot.dipole))
 
     @property
     def broadcasts_tf(self):
@@ -194,6 +237,11 @@ class StatePublisher:
             sample.stamp_ns, sample.q_body, sample.omega_body,
             _diagonal(orientation), _diagonal(rate)))
         self._imu_bias.publish(self._bias_bytes.pack(sample.stamp_ns, sample.bias_body))
+
+    def publish_magnetic(self, sample):
+        """Publish sensor_msgs/MagneticField (T, body frame) from an engine MagneticSample."""
+        self._magnetic.publish(self._magnetic_bytes.pack(
+            sample.stamp_ns, sample.field_body, _diagonal((sample.variance,) * 3)))
 
     def publish_inertia(self, inertia, stamp_ns):
         """Publish the latched inertia tensor (kg m^2, body frame; the mass is not modelled)."""

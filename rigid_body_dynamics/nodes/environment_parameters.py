@@ -1,0 +1,121 @@
+"""
+The space-environment parameters (orbit, field, magnetorquers, magnetometer), defined once.
+
+attitude_simulator flies them all; attitude_analyzer reads the orbit and the
+gravity gradient (for the libration theory) under the same names, so one
+parameters file (``/**:``) serves both. :func:`environment_from` turns validated
+values into the engine's
+:class:`~rigid_body_dynamics.engine.body.Disturbances`, refusing with a reason
+that names the parameter.
+"""
+
+from ..engine import Disturbances
+from ..physics.environment import (DipoleField, EARTH_RATE, IGRF13_2020, KeplerOrbit,
+                                   MU_EARTH, R_EARTH)
+from ..ros.parameters import ConfigurationError, Param
+
+_IGRF = [float(c) for c in IGRF13_2020]
+
+#: Every environment parameter, by name, in the order the manual lists them.
+ENVIRONMENT_PARAMS = {p.name: p for p in (
+    Param('orbit_elements', 'double[6]', None, 'unset (no orbit)',
+          'Two-body orbit [a (m), e, i, RAAN, argument of perigee, true anomaly at t = 0 '
+          '(rad)] in the world frame (inertial, z the planet\'s rotation axis), solved from '
+          "Kepler's equation at every step; 0 <= e < 1 and the perigee above planet_radius. "
+          'Unset = no orbit (a free body).', read_only=True),
+    Param('orbit_mu', 'double', MU_EARTH, '3.986004418e14 m^3/s^2',
+          "The planet's gravitational parameter mu (m^3/s^2).", low=1e-30, high=1e30,
+          read_only=True),
+    Param('planet_radius', 'double', R_EARTH, '6378137.0 m',
+          'Planet radius (m): the perigee must be above it.', low=0.0, high=1e12,
+          read_only=True),
+    Param('gravity_gradient', 'bool', False, 'false',
+          'The gravity-gradient torque 3 mu / |r|^5 (r_B x I r_B) on the orbit (needs '
+          'orbit_elements), evaluated at every integrator stage.', read_only=True),
+    Param('magnetic_field_model', 'string', 'none', '`none`',
+          "The planet's magnetic field: none, or dipole (the centred tilted dipole of degree "
+          '1; needs orbit_elements). With a field the node takes magnetorquer_cmd.',
+          read_only=True, choices=('dipole', 'none')),
+    Param('magnetic_dipole_coefficients', 'double[3]', _IGRF,
+          '[-29404.8, -1450.9, 4652.5] nT (IGRF-13, 2020.0)',
+          'Gauss coefficients [g10, g11, h11] (nT) of the dipole field, reference radius '
+          '6371.2 km.', read_only=True),
+    Param('earth_rotation_angle', 'double', 0.0, '0.0 rad',
+          'Angle of the Earth-fixed frame about the world z axis at t = 0 (rad).',
+          low=-1e6, high=1e6, read_only=True),
+    Param('earth_rotation_rate', 'double', EARTH_RATE, '7.292115e-05 rad/s',
+          "The planet's rotation rate about z (rad/s): the field turns with it.",
+          low=-1.0, high=1.0, read_only=True),
+    Param('residual_dipole', 'double[3]', [0.0, 0.0, 0.0], '[0, 0, 0] A m^2',
+          "The spacecraft's residual magnetic dipole (A m^2, body frame): torque m x B "
+          '(needs the field).', read_only=True),
+    Param('magnetorquer_max_dipole', 'double[3]', [0.0, 0.0, 0.0], '[0, 0, 0] A m^2',
+          'Limit of each magnetorquer (rods along the body x, y, z; A m^2, 0 = none): '
+          'magnetorquer_cmd components beyond it are clipped and counted.', read_only=True),
+    Param('magnetometer_rate', 'double', 0.0, '0.0 Hz',
+          'Magnetometer samples per simulated second on magnetic_field (Hz, 0 = off; needs '
+          'the field); at most integration_rate, rounded to a whole number of steps.',
+          low=0.0, high=1e5, read_only=True),
+    Param('magnetometer_noise', 'double', 0.0, '0.0 T',
+          'White noise of the magnetometer (T, 1 sigma per axis); its covariance is '
+          'noise^2 on the diagonal.', low=0.0, high=1.0, read_only=True),
+    Param('magnetometer_bias', 'double[3]', [0.0, 0.0, 0.0], '[0, 0, 0] T',
+          'Constant bias of the magnetometer (T, body frame); not in the covariance.',
+          read_only=True),
+    Param('lvlh_frame', 'string', 'lvlh', '`lvlh`',
+          'Frame id of the orbit\'s LVLH frame (z nadir, y minus the orbit normal), '
+          'broadcast as world_frame -> lvlh_frame on /tf with an orbit.', read_only=True),
+)}
+
+
+def environment_params(*names):
+    """Return the Params called ``names`` (all when none is named), for a ParameterTable."""
+    return [ENVIRONMENT_PARAMS[n] for n in (names or ENVIRONMENT_PARAMS)]
+
+
+def orbit_from(out):
+    """Return the KeplerOrbit of validated values ``out`` (None unset); refusals name it."""
+    if out.get('orbit_elements') is None:
+        return None
+    try:
+        return KeplerOrbit(out['orbit_elements'], out['orbit_mu'], out['planet_radius'])
+    except ValueError as err:
+        raise ConfigurationError(str(err)) from None
+
+
+def environment_from(out):
+    """
+    Return the engine's Disturbances of a simulator's validated values ``out``.
+
+    Reads disturbance_torque_body / _world and every environment parameter;
+    refuses (ConfigurationError, naming the parameter) a gravity gradient, field
+    or magnetometer without what it needs.
+    """
+    orbit = orbit_from(out)
+    field = None
+    if out['magnetic_field_model'] == 'dipole':
+        if orbit is None:
+            raise ConfigurationError('magnetic_field_model dipole needs orbit_elements (the '
+                                     'field depends on the position)')
+        try:
+            field = DipoleField(out['magnetic_dipole_coefficients'],
+                                out['earth_rotation_angle'], out['earth_rotation_rate'])
+        except ValueError as err:
+            raise ConfigurationError(str(err)) from None
+    if out['gravity_gradient'] and orbit is None:
+        raise ConfigurationError('gravity_gradient needs orbit_elements (the torque depends on '
+                                 'the position)')
+    for name in ('residual_dipole', 'magnetometer_bias'):
+        if any(out[name]) and field is None:
+            raise ConfigurationError(f'{name} needs magnetic_field_model dipole')
+    if out['magnetometer_rate'] > 0.0 and field is None:
+        raise ConfigurationError('magnetometer_rate > 0 needs magnetic_field_model dipole')
+    if any(c < 0.0 for c in out['magnetorquer_max_dipole']):
+        raise ConfigurationError('magnetorquer_max_dipole must be >= 0 per axis (0 = no limit), '
+                                 f'got {list(out["magnetorquer_max_dipole"])}')
+    if out['magnetometer_rate'] > out['integration_rate']:
+        raise ConfigurationError(f'magnetometer_rate must be at most integration_rate '
+                                 f'({out["integration_rate"]:g} Hz), got '
+                                 f'{out["magnetometer_rate"]:g}')
+    return Disturbances(out['disturbance_torque_body'], out['disturbance_torque_world'], orbit,
+                        field, out['gravity_gradient'], out['residual_dipole'])

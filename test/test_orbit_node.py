@@ -1,0 +1,150 @@
+"""
+attitude_simulator in orbit, over real topics (the node is its own process).
+
+The orbit on odom against Kepler, the magnetometer against the dipole formula in
+the Earth-fixed frame, magnetorquer commands (clipped, refused, counted) and the
+attitude replayed offline from applied_dipole, and bad environment parameters
+refused at start naming the parameter.
+"""
+
+import math
+
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import Vector3Stamped
+from nav_msgs.msg import Odometry
+import numpy as np
+import pytest
+from rigid_body_dynamics.physics import make_integrator
+from rigid_body_dynamics.physics.environment import (DipoleField, GravityGradient, KeplerOrbit,
+                                                     MagneticDipole, MU_EARTH, SpaceEnvironment)
+from rigid_body_dynamics.ros.conversions import time_ns, vector_array
+from ros_harness import odom_arrays
+from scipy.spatial.transform import Rotation
+from sensor_msgs.msg import MagneticField
+
+SIM = 'rigid_body_dynamics.nodes.simulator'
+ELEMENTS = [7.0e6, 0.01, 1.2, 0.4, 0.2, 0.1]
+MOMENTS = (2.0, 3.0, 1.0)
+RESIDUAL = (0.01, 0.0, -0.02)
+BIAS = (1e-7, -2e-7, 3e-7)
+ORBIT = ('-p', 'publish_clock:=true', '-p', f'inertia:={list(MOMENTS)}',
+         '-p', 'initial_angular_velocity:=[0.3, -0.5, 0.8]', '-p', f'orbit_elements:={ELEMENTS}',
+         '-p', 'gravity_gradient:=true', '-p', 'magnetic_field_model:=dipole',
+         '-p', 'earth_rotation_angle:=0.3', '-p', f'residual_dipole:={list(RESIDUAL)}',
+         '-p', 'magnetorquer_max_dipole:=[0.5, 0.0, 0.2]', '-p', 'magnetometer_rate:=100.0',
+         '-p', f'magnetometer_bias:={list(BIAS)}', '-p', 'torque_timeout:=0.0',
+         '-p', 'publish_rate:=1000.0')
+
+
+def _dipole(k):
+    return Vector3Stamped(vector=type(Vector3Stamped().vector)(
+        x=0.4 * math.sin(k), y=2.0 * math.cos(k), z=0.3 + 0.01 * k))
+
+
+def test_orbit_field_and_magnetorquers_over_topics(launch, probe):
+    """
+    Position on odom = Kepler (1e-12 relative), its velocity in the body frame; the
+    magnetometer = the dipole formula at odom's attitude plus the bias (1e-12 of |B|); a
+    schedule of magnetorquer_cmd (z over its limit, y unlimited, one NaN, one in the world
+    frame) replayed offline from applied_dipole: q and omega within 1e-12.
+    """
+    proc = launch(SIM, *ORBIT, name='sim')
+    odom = probe.subscribe(Odometry, 'odom')
+    field = probe.subscribe(MagneticField, 'magnetic_field')
+    applied = probe.subscribe(Vector3Stamped, 'applied_dipole')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    probe.wait_for('odom', 5)
+    pub = probe.publisher(Vector3Stamped, 'magnetorquer_cmd')
+    probe.handshake(pub, _dipole(0), lambda: any(m.vector.y for m in applied))
+    for k in range(1, 8):
+        probe.spin_for(0.03)
+        pub.publish(_dipole(k))
+        if k == 3:
+            bad = _dipole(k)
+            bad.vector.x = math.nan
+            pub.publish(bad)
+            world = _dipole(k)
+            world.header.frame_id = 'odom'
+            pub.publish(world)
+    probe.spin_for(0.1)
+    orbit = KeplerOrbit(ELEMENTS)
+    dipole_field = DipoleField(rotation_angle=0.3)
+    by_stamp = {time_ns(m.header.stamp): m for m in odom}
+    # the orbit and the velocity in the body frame
+    worst_r = worst_v = 0.0
+    for t_ns, msg in by_stamp.items():
+        r, v = orbit.state(t_ns * 1e-9)
+        p = msg.pose.pose.position
+        worst_r = max(worst_r, np.linalg.norm(np.subtract((p.x, p.y, p.z), r)) / np.linalg.norm(r))
+        q = odom_arrays([msg])[1][0]
+        v_body = Rotation.from_quat(q).inv().apply(v)
+        worst_v = max(worst_v, np.linalg.norm(vector_array(msg.twist.twist.linear) - v_body)
+                      / np.linalg.norm(v))
+    assert worst_r < 1e-12 and worst_v < 1e-12, (worst_r, worst_v)
+    # the magnetometer against the formula in the Earth-fixed frame, at odom's attitude
+    g10, g11, h11 = -29404.8e-9, -1450.9e-9, 4652.5e-9
+    d = np.array([g11, h11, g10])
+    checked = 0
+    for m in field:
+        t_ns = time_ns(m.header.stamp)
+        if t_ns not in by_stamp:
+            continue
+        t = t_ns * 1e-9
+        to_fixed = Rotation.from_euler('z', -(0.3 + 7.2921150e-5 * t))
+        r_f = to_fixed.apply(orbit.position(t))
+        rn = np.linalg.norm(r_f)
+        b_w = to_fixed.inv().apply((6371.2e3 / rn) ** 3 * (3 * (d @ r_f) / rn ** 2 * r_f - d))
+        q = odom_arrays([by_stamp[t_ns]])[1][0]
+        expected = Rotation.from_quat(q).inv().apply(b_w) + BIAS
+        assert np.linalg.norm(vector_array(m.magnetic_field) - expected) < 1e-12 * np.linalg.norm(
+            b_w)
+        assert m.header.frame_id == 'base_link' and m.magnetic_field_covariance[0] == 0.0
+        checked += 1
+    assert checked >= 20
+    # the attitude replayed offline: each step under the dipole applied_dipole reports for it
+    dipoles = {time_ns(m.header.stamp): tuple(vector_array(m.vector)) for m in applied}
+    used = {u for u in dipoles.values() if any(u)}
+    assert all(abs(u[2]) <= 0.2 and u[0] <= 0.4 for u in used) and any(u[2] == 0.2 for u in used)
+    assert any(abs(u[1]) > 1.0 for u in used)                 # 0 = no limit on y
+    assert not any(map(math.isnan, (c for u in used for c in u)))
+    first = min(t for t, u in dipoles.items() if any(u))
+    start, end = first - 1_000_000, max(dipoles)
+    _, q0, w0 = odom_arrays([by_stamp[start]])
+    ref = make_integrator('exact', MOMENTS, 1e-3, q0[0], w0[0])
+    static = [GravityGradient(MOMENTS, MU_EARTH), MagneticDipole(RESIDUAL)]
+    worst = 0.0
+    for k in range(1, (end - start) // 1_000_000 + 1):
+        t = start + k * 1_000_000
+        env = SpaceEnvironment(orbit, dipole_field, static + [MagneticDipole(dipoles[t])],
+                               epoch=start * 1e-9)
+        ref.step((0.0, 0.0, 0.0), None, env)
+        if t in by_stamp:
+            _, q, w = odom_arrays([by_stamp[t]])
+            worst = max(worst, float(np.max(np.abs(q[0] - ref.q))),
+                        float(np.max(np.abs(w[0] - ref.omega))))
+    assert worst < 1e-12
+    probe.spin_until(lambda: (probe.newest_status('magnetorquers') or (0, '', {}))[2].get(
+        'rejected_frame') == '1', 10.0, 'the refused magnetorquer commands counted')
+    _, message, values = probe.newest_status('magnetorquers')
+    assert values['rejected_non_finite'] == '1' and int(values['clipped']) >= 1, values
+    assert '2 rejected' in message
+    code, _ = proc.stop()
+    assert code == 0, proc.output()
+
+
+@pytest.mark.parametrize('args, reason', [
+    (('-p', 'orbit_elements:=[7.0e6, 1.2, 0.0, 0.0, 0.0, 0.0]'), 'eccentricity'),
+    (('-p', 'orbit_elements:=[6.0e6, 0.0, 0.0, 0.0, 0.0, 0.0]'), 'perigee radius'),
+    (('-p', 'orbit_elements:=[7.0e6, 0.0, 0.0]'), 'orbit_elements must have 6 numbers'),
+    (('-p', 'gravity_gradient:=true'), 'gravity_gradient needs orbit_elements'),
+    (('-p', 'magnetic_field_model:=dipole'), 'magnetic_field_model dipole needs orbit_elements'),
+    (('-p', 'magnetometer_rate:=10.0'), 'magnetometer_rate > 0 needs magnetic_field_model'),
+    (('-p', 'orbit_elements:=[7.0e6, 0.0, 0.0, 0.0, 0.0, 0.0]', '-p',
+      'magnetic_field_model:=dipole', '-p', 'magnetorquer_max_dipole:=[0.1, -0.1, 0.1]'),
+     'magnetorquer_max_dipole must be >= 0'),
+    (('-p', 'magnetic_field_model:=igrf'), 'magnetic_field_model must be one of'),
+])
+def test_bad_environment_parameters_are_refused_at_start_naming_them(launch, args, reason):
+    proc = launch(SIM, *args, name='bad_environment')
+    assert proc.wait(20.0) == 1
+    assert reason in proc.output(), proc.output()
