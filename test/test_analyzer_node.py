@@ -412,7 +412,8 @@ def test_disturbances_keep_the_balance_laws_ok(launch, probe):
     """
     sim = launch(SIM, '-p', 'publish_clock:=true', '-p', 'inertia:=[2.0, 3.0, 1.0]',
                  '-p', 'initial_angular_velocity:=[0.3, -0.2, 0.6]',
-                 '-p', 'gravity_gradient_orbit_rate:=0.5',
+                 '-p', 'orbit_mu:=1.0', '-p', 'planet_radius:=0.0', '-p', 'gravity_gradient:=true',
+                 '-p', f'orbit_elements:=[{0.25 ** (-1 / 3)!r}, 0.0, 0.0, 0.0, 0.0, 0.0]',
                  '-p', 'disturbance_torque_body:=[0.01, 0.0, 0.0]',
                  '-p', 'disturbance_torque_world:=[0.0, 0.0, -0.01]',
                  '-p', 'real_time_factor:=3.0', name='sim')

@@ -120,7 +120,11 @@ def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs
     env = tf2_msgs_env               # so /tf is there too (publish_tf is on by default)
     modules = {'attitude_simulator': ('simulator', ['-p', 'publish_clock:=true',
                                                     '-p', 'wheel_axes:=[0.0, 0.0, 1.0]',
-                                                    '-p', 'wheel_inertia:=[0.01]']),
+                                                    '-p', 'wheel_inertia:=[0.01]',
+                                                    '-p', 'orbit_elements:=[7.0e6, 0.0, 0.0, '
+                                                    '0.0, 0.0, 0.0]',
+                                                    '-p', 'magnetic_field_model:=dipole',
+                                                    '-p', 'magnetometer_rate:=10.0']),
                'attitude_analyzer': ('analyzer', []), 'poinsot_visualizer': ('poinsot', []),
                'attitude_controller': ('controller', [
                    '-p', 'actuator:=wheels', '-p', 'wheel_axes:=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, '
@@ -131,7 +135,7 @@ def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs
               'poinsot_visualizer': poinsot.PARAMETERS,
               'attitude_controller': controller.PARAMETERS}
     for node, interfaces in NODES.items():
-        want = interfaces.resolved('/')          # publish_clock on, a wheel, other defaults
+        want = interfaces.resolved('/')    # publish_clock, a wheel, an orbit with a field, defaults
 
         def have():
             out = {kind: probe.endpoints(kind, node) for kind in ('pub', 'srv')}

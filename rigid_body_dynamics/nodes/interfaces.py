@@ -101,9 +101,16 @@ SIMULATOR = Interfaces('attitude_simulator', [
               'and timed out like `torque_cmd`; a wrong length or a non-finite value is '
               'refused and counted. In lockstep a wheel_cmd answers the tick it comes in.',
               'if `wheel_axes` is set'),
+    Interface('sub', 'magnetorquer_cmd', 'geometry_msgs/msg/Vector3Stamped',
+              'Magnetorquer dipole (A m^2) along the body axes, frame id `body_frame` or empty; '
+              'each axis clipped to `magnetorquer_max_dipole`; held and timed out like '
+              '`torque_cmd`; torque m x B at every integrator stage. In lockstep a stamped one '
+              'answers a tick as `torque_cmd` does (`lockstep_answer`).',
+              'if `magnetic_field_model` is dipole'),
     Interface('pub', 'odom', 'nav_msgs/msg/Odometry',
               '`world_frame` -> `body_frame`: orientation body -> world, twist.angular = omega '
-              '(rad/s, body frame); position 0.'),
+              '(rad/s, body frame); with an orbit pose.position = r (m, world) and '
+              'twist.linear = v in the body frame (m/s), else 0.'),
     Interface('pub', 'orientation', 'geometry_msgs/msg/QuaternionStamped',
               'Body -> world, `world_frame`.', 'if in `state_topics`'),
     Interface('pub', 'angular_velocity', 'geometry_msgs/msg/Vector3Stamped',
@@ -121,6 +128,14 @@ SIMULATOR = Interfaces('attitude_simulator', [
               'The wheels at the odom stamp: name `wheel_0`.., position the wheel angle (rad), '
               'velocity Omega (rad/s relative to the body), effort the motor torque applied '
               'after the limits (N m).', 'if `wheel_axes` is set'),
+    Interface('pub', 'applied_dipole', 'geometry_msgs/msg/Vector3Stamped',
+              'The magnetorquer dipole (A m^2, `body_frame`) held over the step that ended at '
+              'the odom stamp, after the limits (zero after a timeout).',
+              'if `magnetic_field_model` is dipole'),
+    Interface('pub', 'magnetic_field', 'sensor_msgs/msg/MagneticField',
+              'The magnetometer at `magnetometer_rate`: the field (T, `body_frame`) plus '
+              '`magnetometer_bias` and white noise; covariance noise^2 on the diagonal.',
+              'if `magnetometer_rate` > 0'),
     Interface('pub', 'imu', 'sensor_msgs/msg/Imu',
               'REP 145 gyro at `imu_rate`: measured angular velocity and orientation with the '
               'gyro error model and their covariances; no acceleration (covariance[0] = -1).',
@@ -132,11 +147,12 @@ SIMULATOR = Interfaces('attitude_simulator', [
     Interface('pub', '/clock', 'rosgraph_msgs/msg/Clock',
               'Simulated time; best effort, depth 1.', 'if `publish_clock`'),
     Interface('pub', '/tf', 'tf2_msgs/msg/TFMessage',
-              "`world_frame` -> `body_frame` at every odom stamp (rotation only); tf2_ros' "
+              "`world_frame` -> `body_frame` at every odom stamp (rotation only; with an orbit "
+              'the position too, and `world_frame` -> `lvlh_frame`); tf2_ros\' '
               'broadcaster QoS.', 'if `publish_tf` and tf2_msgs is importable'),
     Interface('pub', '/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray',
               '1 Hz: `<node>: integrator` and `<node>: torque command` statuses (and '
-              '`<node>: reaction wheels` with wheels).'),
+              '`<node>: reaction wheels` with wheels, `<node>: magnetorquers` with a field).'),
     Interface('pub', '~/real_time_factor', 'std_msgs/msg/Float64',
               'Achieved real-time factor, 1 Hz (simulated over wall time between wakes; 0 '
               'while paused).'),
