@@ -4,7 +4,8 @@ Attitude control laws (ROS-free), so a closed loop can run offline and in the no
 A law is a callable ``law(q, omega) -> torque``: q (x, y, z, w) body -> world,
 omega (rad/s, body frame), torque (N m, body frame) as a 3-tuple. In
 :func:`~rigid_body_dynamics.physics.simulate` it closes the loop with
-``torque=lambda t, q, w: law(q, w)``.
+``torque=lambda t, q, w: law(q, w)``. :class:`BDot` is a magnetorquer law: it
+answers magnetometer readings with a dipole.
 """
 
 import math
@@ -86,6 +87,44 @@ class RateDamper:
         d1, d2, d3 = self.kd
         w1, w2, w3 = (float(c) for c in omega)
         return _saturate((-d1 * w1, -d2 * w2, -d3 * w3), self.max_torque)
+
+
+class BDot:
+    """
+    B-dot detumbling with magnetorquers: m = -k dB/dt, saturated per axis (Stickler & Alfriend).
+
+    ``gain`` k (A m^2 s / T, > 0), ``max_dipole`` (A m^2 per body axis, 0 = none).
+    :meth:`dipole` takes one magnetometer reading (t s, B T in the body frame)
+    and returns the dipole (A m^2, body frame): dB/dt by the difference with the
+    previous reading, zero for the first reading (and after time went back, e.g.
+    a reset); a dipole over a limit is scaled down as a whole (its direction kept)
+    until every axis is within its limit. In the body frame dB/dt = -omega x B
+    plus the field's slow change along the orbit, so m x B = -k (B x (omega x B))
+    removes rate about every axis but the field's.
+    """
+
+    def __init__(self, gain, max_dipole=(0.0, 0.0, 0.0)):
+        if not (gain > 0.0 and math.isfinite(gain)):
+            raise ValueError(f'gain must be positive and finite, got {gain!r}')
+        self.gain = float(gain)
+        self.max_dipole = tuple(float(c) for c in max_dipole)
+        if len(self.max_dipole) != 3 or not all(c >= 0.0 for c in self.max_dipole):
+            raise ValueError(f'max_dipole must be three numbers >= 0, got {max_dipole!r}')
+        self._last = None
+
+    def dipole(self, t, field_body):
+        """Return the dipole (A m^2, body frame) for the reading ``field_body`` (T) at t (s)."""
+        b = tuple(float(c) for c in field_body)
+        last, self._last = self._last, (t, b)
+        if last is None or t <= last[0]:
+            return (0.0, 0.0, 0.0)
+        k = -self.gain / (t - last[0])
+        m = [k * (b[i] - last[1][i]) for i in range(3)]
+        scale = max([abs(c) / top for c, top in zip(m, self.max_dipole) if top > 0.0],
+                    default=0.0)
+        if scale > 1.0:
+            m = [c / scale for c in m]
+        return tuple(m)
 
 
 class QuaternionPD:

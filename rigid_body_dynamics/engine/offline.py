@@ -1,0 +1,49 @@
+"""
+Closed loops without ROS on the engine's one stepping core (what the node runs, offline).
+
+:func:`detumble` flies B-dot (:class:`~rigid_body_dynamics.physics.control.BDot`) on a
+:class:`~.body.BodySimulation` with a magnetometer and magnetorquers: at every
+magnetometer sample the law's dipole is held from that sample's time on, as
+attitude_controller's ``bdot`` mode answers ``magnetic_field`` with
+``magnetorquer_cmd`` in lockstep.
+"""
+
+import math
+
+from .body import MagneticSample
+from .commands import DipoleCommands
+
+
+def detumble(body, law, duration, target_rate=math.radians(0.5)):
+    """
+    Fly ``law`` (BDot) on ``body`` for ``duration`` s; return what happened.
+
+    ``body``: a BodySimulation with magnetorquers and a magnetometer (its
+    ``magnetometer_every`` steps are the control period). Returns a dict: the
+    sample ``times`` (s), ``rates`` |omega| (rad/s) and ``dipoles`` (A m^2, body)
+    at each, and ``reached`` the first time (s) |omega| <= ``target_rate`` (rad/s),
+    or None.
+    """
+    every = body.magnetometer_every
+    if not every or body.max_dipole is None:
+        raise ValueError('detumble needs a body with magnetorquers and a magnetometer')
+    times, rates, dipoles, reached = [], [], [], None
+    with body.lock:
+        items = body.first_items()
+        for _ in range(int(round(duration / (every * body.dt)))):
+            for item in items:
+                if isinstance(item, MagneticSample):
+                    t = item.stamp_ns * 1e-9
+                    m = law.dipole(t, item.field_body)
+                    body.hold(body.check(DipoleCommands.one(m, 0, item.stamp_ns)), 0, 1)
+                    w = body.stepper.omega
+                    rate = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+                    times.append(t)
+                    rates.append(rate)
+                    dipoles.append(m)
+                    if reached is None and rate <= target_rate:
+                        reached = t
+            items = []
+            for _ in range(every):
+                body.advance(0, items)
+    return {'times': times, 'rates': rates, 'dipoles': dipoles, 'reached': reached}
