@@ -9,8 +9,8 @@ t_k on (zero-order hold) and the body integrates to t_{k+1} as fast as it can. S
 then a function of the commands only: the same controller gives the same
 trajectory, bit for bit, however loaded the machine is.
 
-Before the first command the wait has no limit (the state at t_0 goes out
-again every ``REPEAT`` s, so a late controller finds it). After it, a tick
+Before the first command the wait has no limit (the state and sensor samples at
+t_0 go out again every ``REPEAT`` s, so a late controller finds them). After it, a tick
 whose command does not come within ``timeout`` (wall s; 0 = wait for ever)
 is a miss: counted, noted for the log, and the last command is held. A
 command stamped before the current tick (an answer that came too late) is
@@ -138,7 +138,8 @@ class Lockstep(Pace):
                 return 0.0
             if self._first and now - self._last_repeat >= REPEAT * _NS:
                 self._last_repeat = now
-                outbox.append(body.snapshot())          # for a controller that comes late
+                # for a controller that comes late: the state and samples of t_0 again
+                outbox.extend(self.start_items or [body.snapshot()])
                 return 0.0
             left = (self.timeout_ns - waited) / _NS if self.timeout_ns and not self._first \
                 else WAIT_SLICE

@@ -79,6 +79,7 @@ class Pace:
         self.clock, self.perf = clock, perf
         self.on_backlog = on_backlog or (lambda steps: None)
         self.missed = 0
+        self.start_items = None    # the items of the current start (first_items)
         self.max_late_ns = 0
         self.phase = 0.0
         self._on_move = []          # called by anchor(): see on_move
@@ -151,6 +152,16 @@ class Pace:
     def restart(self):
         """After a reset of the body: as :meth:`begin`."""
         self.begin()
+
+    def first_items(self):
+        """
+        Return the body's items at its current time (state, sensor samples; under its lock).
+
+        Kept, so that lockstep can send them again to a controller that comes late
+        without drawing the sensors' noise a second time.
+        """
+        self.start_items = self.body.first_items()
+        return self.start_items
 
     def set_rtf(self, rtf):
         """Change the real-time factor (re-anchors)."""

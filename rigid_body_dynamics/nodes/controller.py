@@ -23,6 +23,12 @@ stamp (``wheel_state``), and ``torque_cmd`` (stamped, published first at every
 answer) carries the momentum dump, zero unless a wheel is near its speed limit.
 With the simulator in lockstep set its ``lockstep_answer`` to ``both``.
 
+``mode: bdot`` (``actuator: magnetorquers``) detumbles with magnetorquers: each
+``magnetic_field`` reading (the simulator's magnetometer, or any) is answered with
+a ``magnetorquer_cmd`` stamped with the reading's stamp, m = -k dB/dt
+(:class:`~rigid_body_dynamics.physics.control.BDot`), within
+``magnetorquer_max_dipole``; it needs no inertia and no odom.
+
 States are taken by a thread of their own from a wait set (ros/intake.py),
 not by executor callbacks: one DDS hop less of Python overhead per period.
 """
@@ -31,15 +37,16 @@ import math
 import sys
 import threading
 
-from geometry_msgs.msg import InertiaStamped, QuaternionStamped, WrenchStamped
+from geometry_msgs.msg import InertiaStamped, QuaternionStamped, Vector3Stamped, WrenchStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.serialization import deserialize_message
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import JointState, MagneticField
 from std_msgs.msg import Float64MultiArray
 
+from .environment_parameters import environment_params
 from .wheel_parameters import wheel_params, wheels_from
-from ..physics.control import QuaternionPD, RateDamper, WheelAllocator
+from ..physics.control import BDot, QuaternionPD, RateDamper, WheelAllocator
 from ..ros import conversions as conv
 from ..ros.intake import Intake
 from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
@@ -57,6 +64,14 @@ def _target(value):
     if not norm > 1e-9:
         raise ConfigurationError('target_orientation must not be the zero quaternion')
     return tuple(c / norm for c in q)
+
+
+def _actuator(values, out):
+    """Cross-check: bdot and the magnetorquers go together."""
+    if (out['mode'] == 'bdot') != (out['actuator'] == 'magnetorquers'):
+        raise ConfigurationError('mode bdot and actuator magnetorquers go together (B-dot '
+                                 f'flies magnetorquers), got mode {out["mode"]} with actuator '
+                                 f'{out["actuator"]}')
 
 
 def _allocator(values, out):
@@ -77,8 +92,9 @@ def _allocator(values, out):
 #: The parameters of attitude_controller (the manual's table is made from this; test_docs checks).
 PARAMETERS = ParameterTable([
     Param('mode', 'string', 'slew', '`slew`',
-          'slew: quaternion PD to target_orientation; detumble: rate damping only.',
-          choices=('detumble', 'slew')),
+          'slew: quaternion PD to target_orientation; detumble: rate damping only; bdot: '
+          'B-dot detumbling with magnetorquers from magnetic_field (actuator magnetorquers).',
+          choices=('bdot', 'detumble', 'slew')),
     Param('target_orientation', 'double[4]', [0.0, 0.0, 0.0, 1.0], '[0, 0, 0, 1]',
           'Target attitude (x, y, z, w), body -> world; normalised. A message on '
           'target_orientation overrides it.', convert=_target),
@@ -95,8 +111,9 @@ PARAMETERS = ParameterTable([
           low=0.0, high=1e6),
     Param('actuator', 'string', 'torque', '`torque`',
           "torque: the law's torque on torque_cmd; wheels: flown by the reaction wheels "
-          '(wheel_cmd), torque_cmd carrying only the momentum dump.',
-          choices=('torque', 'wheels'), read_only=True),
+          '(wheel_cmd), torque_cmd carrying only the momentum dump; magnetorquers: the '
+          'dipole of mode bdot on magnetorquer_cmd.',
+          choices=('magnetorquers', 'torque', 'wheels'), read_only=True),
     *wheel_params('wheel_axes', 'wheel_inertia', 'wheel_max_torque', 'wheel_max_speed'),
     Param('dump_fraction', 'double', 0.8, '0.8',
           'Momentum dumping starts when a wheel passes this fraction of its speed limit and '
@@ -105,7 +122,10 @@ PARAMETERS = ParameterTable([
     Param('dump_gain', 'double', 0.5, '0.5 1/s',
           "Dump torque -dump_gain h_w on torque_cmd (h_w the wheels' momentum, body frame).",
           low=0.0, high=1e6, read_only=True),
-], cross_checks=(_allocator,))
+    Param('bdot_gain', 'double', 1e5, '1e5 A m^2 s/T',
+          'B-dot gain k: m = -k dB/dt (mode bdot).', low=0.0, high=1e15, above_low=True),
+    *environment_params('magnetorquer_max_dipole'),
+], cross_checks=(_actuator, _allocator))
 
 
 class AttitudeController(Node):
@@ -122,6 +142,10 @@ class AttitudeController(Node):
         self._next_due_ns = None
         self._last_ns = None
         self.answered = 0
+        self._bdot = self._values['mode'] == 'bdot'
+        if self._bdot:
+            self._pub_dipole = self.create_publisher(Vector3Stamped, 'magnetorquer_cmd',
+                                                     STATE_QOS)
         self._pub = self.create_publisher(WrenchStamped, 'torque_cmd', STATE_QOS)
         self._allocator = self._values['allocator']
         self._wheel_states = {}                # stamp (ns) -> wheel speeds, recent ones
@@ -132,11 +156,19 @@ class AttitudeController(Node):
                                  STATE_QOS)
         self._intake = Intake(self)
         self._intake.subscribe(Odometry, 'odom', STATE_QOS)
+        if self._bdot:
+            self._intake.subscribe(MagneticField, 'magnetic_field', STATE_QOS)
         if self._allocator is not None:
             self._intake.subscribe(JointState, 'wheel_state', STATE_QOS)
         self.add_on_set_parameters_callback(lambda params: PARAMETERS.on_set(self, params))
         self.add_post_set_parameters_callback(self._on_parameters)
         v = self._values
+        if self._bdot:
+            self._rebuild()
+            self.get_logger().info(
+                f'bdot: k = {v["bdot_gain"]:g} A m^2 s/T, dipole limits '
+                f'{list(v["magnetorquer_max_dipole"])} A m^2, answering magnetic_field')
+            return
         self.get_logger().info(
             f'{v["mode"]}: wn = {v["natural_frequency"]:g} rad/s, zeta = '
             f'{v["damping_ratio"]:g}, max_torque = {v["max_torque"]:g} N m, '
@@ -146,7 +178,9 @@ class AttitudeController(Node):
     def _rebuild(self):
         """Make the law from the values and the inertia (call under the lock)."""
         v = self._values
-        if self._moments is None:
+        if v['mode'] == 'bdot':
+            self._law = BDot(v['bdot_gain'], v['magnetorquer_max_dipole'])
+        elif self._moments is None:
             self._law = None
         elif v['mode'] == 'detumble':
             self._law = RateDamper(self._moments, v['natural_frequency'], v['damping_ratio'],
@@ -198,6 +232,9 @@ class AttitudeController(Node):
             self._thread.join(timeout=5.0)
 
     def _loop(self):
+        if self._bdot:
+            self._bdot_loop()
+            return
         while not self._stop.is_set():
             if not self._intake.wait('odom', 0.1):
                 continue
@@ -213,6 +250,38 @@ class AttitudeController(Node):
                 self.get_logger().warning('no wheel_state with the stamp of odom: not answered')
                 continue
             self.answer(odom, speeds)
+
+    def _bdot_loop(self):
+        while not self._stop.is_set():
+            if not self._intake.wait('magnetic_field', 0.1):
+                continue
+            for raw in self._intake.take('magnetic_field'):
+                self.answer_field(deserialize_message(raw, MagneticField))
+
+    def answer_field(self, msg):
+        """
+        Answer one magnetometer reading with a magnetorquer_cmd of the reading's stamp.
+
+        Every reading goes through the law (its dB/dt needs each); one is answered when
+        due at ``control_rate``, as states are.
+        """
+        stamp = conv.time_ns(msg.header.stamp)
+        with self._lock:
+            law = self._law
+            if self._last_ns is not None and stamp < self._last_ns:
+                self._next_due_ns = None           # the simulator was reset: start over
+            self._last_ns = stamp
+            dipole = law.dipole(stamp * 1e-9, conv.vector_array(msg.magnetic_field))
+            if self._next_due_ns is not None and stamp < self._next_due_ns:
+                return
+            rate = self._values['control_rate']
+            self._next_due_ns = stamp + (round(1e9 / rate) if rate > 0.0 else 1)
+        cmd = Vector3Stamped()
+        cmd.header.stamp = msg.header.stamp
+        cmd.header.frame_id = msg.header.frame_id
+        cmd.vector.x, cmd.vector.y, cmd.vector.z = dipole
+        self._pub_dipole.publish(cmd)
+        self.answered += 1
 
     def _speeds_at(self, stamp_ns):
         """Return the wheel speeds stamped ``stamp_ns``, waiting for them a little; or None."""

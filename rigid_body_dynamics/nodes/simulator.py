@@ -160,7 +160,7 @@ class AttitudeSimulator(Node):
         self._make_interfaces()
         self.state.publish_inertia(self.body.inertia, start_ns)
         with self.body.lock:
-            items = self.body.first_items()
+            items = self.pace.first_items()
         for item in items:
             self.state.publish(item)
         self.add_on_set_parameters_callback(self._on_set_parameters)
@@ -387,7 +387,7 @@ class AttitudeSimulator(Node):
         with self.body.lock:
             self.body.reset()
             self.pace.restart()
-            items = self.body.first_items()
+            items = self.pace.first_items()
         for item in items:
             self.state.publish(item)
         self.get_logger().info('reset to the initial state, simulated time 0')
