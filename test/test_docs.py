@@ -135,7 +135,7 @@ def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs
               'poinsot_visualizer': poinsot.PARAMETERS,
               'attitude_controller': controller.PARAMETERS}
     for node, interfaces in NODES.items():
-        want = interfaces.resolved('/')    # publish_clock, a wheel, an orbit with a field, defaults
+        want = interfaces.resolved('/')    # publish_clock, a wheel, an orbit, a field
 
         def have():
             out = {kind: probe.endpoints(kind, node) for kind in ('pub', 'srv')}

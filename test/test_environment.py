@@ -149,12 +149,12 @@ BOX = (0.05, 0.02, 0.03)    # magnetorquer limits (A m^2 per body axis) of the w
 
 
 def _dipole_schedule(k):
-    """A magnetorquer command per 0.1 s (A m^2, body), some over the limits of BOX."""
+    """Return a magnetorquer command per 0.1 s (A m^2, body), some over the limits of BOX."""
     return (0.08 * math.sin(0.7 * k), 0.015 * math.cos(0.3 * k), -0.04 + 0.01 * (k % 5))
 
 
 def _whole_model_run(dt, seconds):
-    """The engine under the whole model and a dipole schedule; returns (body, states, ref)."""
+    """Run the engine under the whole model and a dipole schedule: (body, states, ref)."""
     orbit, field = KeplerOrbit(ELEMENTS), DipoleField(rotation_angle=0.4)
     residual = (0.002, -0.001, 0.003)
     q0, w0 = quaternions.normalize(np.array([0.1, 0.2, -0.3, 0.9])), (0.4, -0.7, 1.1)
@@ -274,6 +274,8 @@ def test_rk4_under_the_environment_is_fourth_order():
 
 def test_bdot_detumbles_a_3u_cubesat_in_a_polar_orbit_within_an_orbit():
     """
+    Detumble a 3U CubeSat with B-dot from 10 deg/s within an orbit.
+
     I = (0.033, 0.033, 0.007) kg m^2 at 10 deg/s, 500 km polar orbit, 0.2 A m^2 rods, B-dot
     k = 1e5 A m^2 s / T at 1 Hz: below 0.5 deg/s within one orbit (5677 s; measured 3719 s),
     the dipole saturates at the rods' limit while the rate is high, and |omega| falls over

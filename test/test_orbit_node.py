@@ -43,6 +43,8 @@ def _dipole(k):
 
 def test_orbit_field_and_magnetorquers_over_topics(launch, probe):
     """
+    Check the orbit, the field and the magnetorquers of a running simulator.
+
     Position on odom = Kepler (1e-12 relative), its velocity in the body frame; the
     magnetometer = the dipole formula at odom's attitude plus the bias (1e-12 of |B|); a
     schedule of magnetorquer_cmd (z over its limit, y unlimited, one NaN, one in the world

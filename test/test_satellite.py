@@ -27,7 +27,7 @@ PARAMS = os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples', 'satel
 
 
 def _offline(seconds):
-    """The YAML's CubeSat and B-dot, flown offline on the engine."""
+    """Fly the YAML's CubeSat and B-dot offline on the engine."""
     with open(PARAMS) as f:
         config = yaml.safe_load(f)
     common = config['/**']['ros__parameters']
@@ -48,6 +48,8 @@ def _offline(seconds):
 
 def test_bdot_detumbles_the_cubesat_over_topics_in_lockstep_as_offline(launch, probe):
     """
+    Detumble over topics in lockstep, bit for bit the offline loop.
+
     600 s simulated (600 lockstep ticks of 1 s): |omega| from 10 deg/s well down, the
     magnetometer readings answered by magnetorquer_cmd with their stamps, and q, omega at
     every tick equal to the offline loop's bit for bit.

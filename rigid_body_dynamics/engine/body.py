@@ -29,7 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .commands import DipoleCommands, TorqueCommands
+from .commands import TorqueCommands
 from ..physics import make_integrator, quaternions
 from ..physics.environment import (GravityGradient, MagneticDipole, Magnetorquers,
                                    SpaceEnvironment)

@@ -20,7 +20,7 @@ _IGRF = [float(c) for c in IGRF13_2020]
 ENVIRONMENT_PARAMS = {p.name: p for p in (
     Param('orbit_elements', 'double[6]', None, 'unset (no orbit)',
           'Two-body orbit [a (m), e, i, RAAN, argument of perigee, true anomaly at t = 0 '
-          '(rad)] in the world frame (inertial, z the planet\'s rotation axis), solved from '
+          "(rad)] in the world frame (inertial, z the planet's rotation axis), solved from "
           "Kepler's equation at every step; 0 <= e < 1 and the perigee above planet_radius. "
           'Unset = no orbit (a free body).', read_only=True),
     Param('orbit_mu', 'double', MU_EARTH, '3.986004418e14 m^3/s^2',
@@ -63,7 +63,7 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
           'Constant bias of the magnetometer (T, body frame); not in the covariance.',
           read_only=True),
     Param('lvlh_frame', 'string', 'lvlh', '`lvlh`',
-          'Frame id of the orbit\'s LVLH frame (z nadir, y minus the orbit normal), '
+          "Frame id of the orbit's LVLH frame (z nadir, y minus the orbit normal), "
           'broadcast as world_frame -> lvlh_frame on /tf with an orbit.', read_only=True),
 )}
 

@@ -147,8 +147,8 @@ SIMULATOR = Interfaces('attitude_simulator', [
     Interface('pub', '/clock', 'rosgraph_msgs/msg/Clock',
               'Simulated time; best effort, depth 1.', 'if `publish_clock`'),
     Interface('pub', '/tf', 'tf2_msgs/msg/TFMessage',
-              "`world_frame` -> `body_frame` at every odom stamp (rotation only; with an orbit "
-              'the position too, and `world_frame` -> `lvlh_frame`); tf2_ros\' '
+              '`world_frame` -> `body_frame` at every odom stamp (rotation only; with an orbit '
+              "the position too, and `world_frame` -> `lvlh_frame`); tf2_ros' "
               'broadcaster QoS.', 'if `publish_tf` and tf2_msgs is importable'),
     Interface('pub', '/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray',
               '1 Hz: `<node>: integrator` and `<node>: torque command` statuses (and '

@@ -91,7 +91,9 @@ class RateDamper:
 
 class BDot:
     """
-    B-dot detumbling with magnetorquers: m = -k dB/dt, saturated per axis (Stickler & Alfriend).
+    B-dot detumbling with magnetorquers (Stickler and Alfriend), saturated per axis.
+
+    The law is m = -k dB/dt.
 
     ``gain`` k (A m^2 s / T, > 0), ``max_dipole`` (A m^2 per body axis, 0 = none).
     :meth:`dipole` takes one magnetometer reading (t s, B T in the body frame)
@@ -113,7 +115,7 @@ class BDot:
         self._last = None
 
     def dipole(self, t, field_body):
-        """Return the dipole (A m^2, body frame) for the reading ``field_body`` (T) at t (s)."""
+        """Return the law's dipole (A m^2, body frame) for ``field_body`` (T) read at t (s)."""
         b = tuple(float(c) for c in field_body)
         last, self._last = self._last, (t, b)
         if last is None or t <= last[0]:
