@@ -115,7 +115,7 @@ class BDot:
         self._last = None
 
     def dipole(self, t, field_body):
-        """Return the moment to command, A m^2 in the body frame, for ``field_body`` (T) at t (s)."""
+        """Return the moment to command (A m^2, body frame) for ``field_body`` (T) at t (s)."""
         b = tuple(float(c) for c in field_body)
         last, self._last = self._last, (t, b)
         if last is None or t <= last[0]:
