@@ -195,7 +195,7 @@ def test_rigid_body_analyze_refuses_a_zero_tolerance(capsys):
 
 
 def _cases():
-    """Return findings of every kind: a top, a racket (flips, and under torque), a short window."""
+    """Return findings of every kind: a top, a racket (flips, under torque), wheels, an orbit."""
     out = {}
     for name, duration, torque in (('symmetric_top', 10.0, None), ('tennis_racket', 50.0, None),
                                    ('tennis_racket', 5.0, (0.0, 0.0, 0.05)),
@@ -210,6 +210,13 @@ def _cases():
     out['wheels exchanging momentum'] = analyse(wheel_trajectory(duration=2.0))
     out['a free gyrostat'] = analyse(_free_gyrostat((1.0, 1.0, 1.5), ((0.0, 0.0, 1.0),), (0.1,),
                                                     (20.0,), (0.3, 0.0, 2.0), 10.0))
+    from scipy.spatial.transform import Rotation
+    from test_libration import _fly, MOMENTS
+    trajectory, _ = _fly(MOMENTS, Rotation.identity(), [0.001, 0.002, -0.0015])
+    out['gravity-gradient libration'] = analyse(trajectory, gravity_gradient=True)
+    trajectory, _ = _fly(MOMENTS, Rotation.identity(), [0.001, 0.0, 0.0],
+                         elements=[7.5e6, 0.01, 1.0, 0.0, 0.0, 0.0], steps=300)
+    out['an eccentric orbit'] = analyse(trajectory, gravity_gradient=True)
     return out
 
 
@@ -283,7 +290,11 @@ def test_the_analyzers_diagnostics_read_back_into_the_same_findings():
                 'omega period, measured (s)',
                 'mean precession of axis 3 about L, measured (rad/s)',
                 'growth rate, measured (1/s)', 'flip interval, measured (s)',
-                'wobble frequency, measured (rad/s)', 'circled axis'):
+                'wobble frequency, measured (rad/s)', 'circled axis',
+                'pitch libration frequency, measured (rad/s)',
+                'roll-yaw libration frequency, slow, measured (rad/s)',
+                'roll-yaw libration frequency, fast, measured (rad/s)',
+                'Jacobi integral drift (rel.)', 'stability region'):
         assert key in seen, key
 
 

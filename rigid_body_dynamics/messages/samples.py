@@ -96,3 +96,31 @@ def torque_batch(raws, decode, body_frame=None):
                                       msg.header.frame_id, body_frame))
     return (np.concatenate([p[0] for p in parts]).astype(np.int64),
             np.concatenate([p[1] for p in parts]).reshape(-1, 3), sum(p[2] for p in parts))
+
+
+def odometry_translation(raws, decode):
+    """
+    Return (t_ns, position m world, velocity m/s world) of serialised nav_msgs/Odometry.
+
+    The velocity is the twist's linear part turned into the world frame by the pose's
+    orientation (Odometry gives it in the child frame; unchanged where the child
+    frame is the world frame). Decoded one by one: an orbit's analysis needs a
+    few samples a second.
+    """
+    t, r, v = [], [], []
+    for raw in raws:
+        msg = decode(raw)
+        p, o, lin = msg.pose.pose.position, msg.pose.pose.orientation, msg.twist.twist.linear
+        vec = (lin.x, lin.y, lin.z)
+        if msg.child_frame_id != msg.header.frame_id:
+            vec = quaternions.rotate_components(_unit((o.x, o.y, o.z, o.w)), vec)
+        t.append(stamp_ns(msg.header.stamp))
+        r.append((p.x, p.y, p.z))
+        v.append(vec)
+    return (np.array(t, dtype=np.int64), np.array(r, dtype=float).reshape(-1, 3),
+            np.array(v, dtype=float).reshape(-1, 3))
+
+
+def _unit(q):
+    n = float(np.linalg.norm(q))
+    return tuple(c / n for c in q) if n > 0.0 and np.isfinite(n) else (0.0, 0.0, 0.0, 1.0)

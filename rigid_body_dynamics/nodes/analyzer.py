@@ -39,6 +39,7 @@ from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
 from . import analyzer_diagnostics as diagnostics
+from .environment_parameters import environment_params
 from .wheel_parameters import wheel_params, wheels_from
 from ..messages import samples
 from ..physics import Inertia
@@ -124,6 +125,12 @@ PARAMETERS = ParameterTable([
           high=3600.0, read_only=True),
     *wheel_params('wheel_axes', 'wheel_inertia', 'wheel_friction_coulomb',
                   'wheel_friction_viscous'),
+    *environment_params('gravity_gradient'),
+    Param('libration_tolerance', 'double', 1e-3, '1e-3',
+          'With gravity_gradient: relative difference between a measured libration frequency '
+          'and the small-angle theory above which the orbit status is WARN (100x: ERROR); '
+          'finite amplitudes differ by about the squared angle.', low=0.0, high=1.0,
+          above_low=True),
 ], cross_checks=(_wheels,))
 
 
@@ -143,6 +150,7 @@ class SampleBuffer:
         self.t, self.q, self.w = [], [], []
         self.torque_t, self.torque = [], []
         self.wheel_t, self.wheel = [], []
+        self.orbit_t, self.orbit = [], []
 
     def add(self, t, q, w, reset_jump, max_gap):
         """Insert one state sample (stamp t, ns) in stamp order; duplicates are dropped."""
@@ -177,6 +185,22 @@ class SampleBuffer:
         self.wheel_t.insert(i, t)
         self.wheel.insert(i, (tuple(speeds), tuple(efforts)))
 
+    def add_orbit(self, t, position, velocity):
+        """Insert one orbit sample (stamp t, ns): position (m) and velocity (m/s), world."""
+        i = bisect.bisect_left(self.orbit_t, t)
+        if i < len(self.orbit_t) and self.orbit_t[i] == t:
+            return
+        self.orbit_t.insert(i, t)
+        self.orbit.insert(i, (tuple(position), tuple(velocity)))
+
+    def orbit_arrays(self):
+        """Return (position, velocity) (N, 3) at the state stamps, or None unless all have one."""
+        found = dict(zip(self.orbit_t, self.orbit))
+        rows = [found.get(t) for t in self.t]
+        if not rows or any(r is None for r in rows):
+            return None
+        return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
+
     def wheel_arrays(self, count):
         """
         Return (speeds, motor torques) (N, count) at the state stamps, or None.
@@ -204,6 +228,8 @@ class SampleBuffer:
         del self.torque_t[:j], self.torque[:j]
         j = bisect.bisect_left(self.wheel_t, keep_from)
         del self.wheel_t[:j], self.wheel[:j]
+        j = bisect.bisect_left(self.orbit_t, keep_from)
+        del self.orbit_t[:j], self.orbit[:j]
 
     def arrays(self):
         """(t ns int64, q, omega, torque at the state stamps); torque 0 where none is known."""
@@ -316,6 +342,11 @@ class AttitudeAnalyzer(Node):
             q = q[good] / norm[good, None]
             for sample in zip(t[good].tolist(), q, w[good]):
                 self._add_odom(*sample)
+            if self._settings['gravity_gradient']:
+                decode = lambda raw: deserialize_message(raw, Odometry)  # noqa: E731
+                for stamp, r, v in zip(*samples.odometry_translation(raws, decode)):
+                    if np.all(np.isfinite(r)) and np.all(np.isfinite(v)):
+                        self._buffer.add_orbit(int(stamp), r, v)
         raws = self._intake.take('applied_torque')
         if raws:
             t, tau, dropped = samples.torque_batch(
@@ -393,13 +424,16 @@ class AttitudeAnalyzer(Node):
         else:
             t, q, w, tau = buf.arrays()
             origin = int(t[0]) if t.size else 0
-            trajectory = Trajectory.from_samples(t, q, w, self._inertia, tau, origin_ns=origin,
-                                                 **self._wheel_samples())
+            orbit = buf.orbit_arrays() if s['gravity_gradient'] else None
+            trajectory = Trajectory.from_samples(
+                t, q, w, self._inertia, tau, origin_ns=origin, **self._wheel_samples(),
+                **({} if orbit is None else {'position': orbit[0], 'velocity': orbit[1]}))
             baseline = None
             if self._baseline is not None:
                 b_t, b_q, b_w = self._baseline
                 baseline = (b_t - origin, b_q, b_w)
-            found = analyse(trajectory, baseline, self._tolerances())
+            found = analyse(trajectory, baseline, self._tolerances(),
+                            gravity_gradient=s['gravity_gradient'])
             if found.kinetic_energy is not None:
                 self._publish('kinetic_energy', found.kinetic_energy)
                 self._publish('angular_momentum_norm', found.angular_momentum_norm)
@@ -433,7 +467,7 @@ class AttitudeAnalyzer(Node):
         s = self._settings
         return Tolerances(energy=s['energy_tolerance'], momentum=s['momentum_tolerance'],
                           balance=s['balance_tolerance'], rate=s['rate_tolerance'],
-                          min_samples=MIN_SAMPLES)
+                          libration=s['libration_tolerance'], min_samples=MIN_SAMPLES)
 
     def _publish(self, topic, value):
         self._pub[topic].publish(Float64(data=value))

@@ -2,7 +2,7 @@
 Findings of the analysis -> diagnostic_msgs/DiagnosticStatus (REP 107) for attitude_analyzer.
 
 Status names are ``<node>: conservation``, ``<node>: precession`` and
-``<node>: stability``; their values are
+``<node>: stability`` (and ``<node>: orbit`` with ``gravity_gradient``); their values are
 :func:`~rigid_body_dynamics.physics.findings_render.key_values` (the one rendering
 of findings to key/values, whose keys the manual's attitude_analyzer page lists),
 and :func:`findings_from` reads them back with
@@ -29,14 +29,15 @@ def statuses(found, name, hardware_id, origin_ns):
     """
     sections = findings_render.key_values(found, origin_ns)
     return [status(f'{name}: {check}', LEVELS[sections[check][0]], sections[check][1],
-                   sections[check][2], hardware_id) for check in CHECKS]
+                   sections[check][2], hardware_id) for check in CHECKS + ('orbit',)
+            if check in sections]
 
 
 def findings_from(received):
     """
     Read an analyzer's statuses back into Findings.
 
-    ``received``: {'conservation' | 'precession' | 'stability': (level byte,
+    ``received``: {'conservation' | 'precession' | 'stability' | 'orbit': (level byte,
     message, {key: value text})}, e.g. from one DiagnosticArray.
     """
     status_of = {DiagnosticStatus.OK: findings.OK, DiagnosticStatus.WARN: findings.WARN,

@@ -25,8 +25,9 @@ import math
 import numpy as np
 
 from . import equations, estimators, quaternions, theory
-from .findings import (ConservationFindings, ERROR, Findings, OK, PrecessionFindings, Quantity,
-                       StabilityFindings, UNAVAILABLE, WARN)
+from .environment.libration import jacobi_integral, libration_modes, oscillation_frequencies
+from .findings import (ConservationFindings, ERROR, Findings, OK, OrbitFindings,
+                       PrecessionFindings, Quantity, StabilityFindings, UNAVAILABLE, WARN)
 from .findings_render import quantity_lines
 from .inertia import as_inertia
 from .tolerances import compare, level, Tolerances, unavailable, worst
@@ -48,8 +49,10 @@ class Trajectory:
     ``inertia`` whose body frame these are in. A body with reaction wheels also has
     ``wheels`` (a :class:`~.gyrostat.Wheels`, body frame), ``wheel_speeds`` (N, n)
     rad/s relative to the body and ``motor_torques`` (N, n) N m (the torques applied
-    over the step ending at each sample). Build with :meth:`from_samples` (sorts,
-    drops duplicates and non-finite samples) or :meth:`from_simulation`.
+    over the step ending at each sample). A body in orbit also has ``position``
+    (N, 3) m and ``velocity`` (N, 3) m/s, both in the world frame (None without).
+    Build with :meth:`from_samples` (sorts, drops duplicates and non-finite samples)
+    or :meth:`from_simulation`.
     """
 
     t_ns: np.ndarray
@@ -63,17 +66,21 @@ class Trajectory:
     wheels: object = None
     wheel_speeds: object = None
     motor_torques: object = None
+    position: object = None
+    velocity: object = None
 
     @classmethod
     def from_samples(cls, t_ns, q, omega, inertia, torque=None, origin_ns=None, title='',
-                     wheels=None, wheel_speeds=None, motor_torques=None):
+                     wheels=None, wheel_speeds=None, motor_torques=None, position=None,
+                     velocity=None):
         """
         Sort by stamp, keep the first of a duplicated stamp, drop non-finite samples.
 
         ``t_ns`` are absolute integer ns stamps; ``origin_ns`` defaults to the
         earliest. ``q`` is normalised (a zero or non-finite quaternion drops
         the sample; ``dropped`` counts those). ``wheels``, ``wheel_speeds`` and
-        ``motor_torques``: see the class (one row per sample, or None).
+        ``motor_torques``, ``position`` and ``velocity``: see the class (one row per
+        sample, or None).
         """
         t_ns = np.asarray(t_ns, dtype=np.int64).reshape(-1)
         q = np.asarray(q, dtype=float).reshape(-1, 4)
@@ -86,13 +93,18 @@ class Trajectory:
             np.asarray(wheel_speeds, dtype=float).reshape(len(w), n)
         motors = np.zeros((len(w), n)) if motor_torques is None else \
             np.asarray(motor_torques, dtype=float).reshape(len(w), n)
+        orbit = position is not None and velocity is not None
+        r = np.asarray(position, dtype=float).reshape(len(w), 3) if orbit else \
+            np.zeros((len(w), 3))
+        v = np.asarray(velocity, dtype=float).reshape(len(w), 3) if orbit else r
         norm = np.linalg.norm(q, axis=1) if len(q) else np.zeros(0)
         good = (np.isfinite(norm) & (norm > 0.5) & np.all(np.isfinite(w), axis=1)
                 & np.all(np.isfinite(tau), axis=1) & np.all(np.isfinite(speeds), axis=1)
-                & np.all(np.isfinite(motors), axis=1))
+                & np.all(np.isfinite(motors), axis=1) & np.all(np.isfinite(r), axis=1)
+                & np.all(np.isfinite(v), axis=1))
         dropped = int(np.count_nonzero(~good))
         t_ns, q, w, tau, norm = t_ns[good], q[good], w[good], tau[good], norm[good]
-        speeds, motors = speeds[good], motors[good]
+        speeds, motors, r, v = speeds[good], motors[good], r[good], v[good]
         order = np.argsort(t_ns, kind='stable')
         keep = np.ones(order.size, dtype=bool)
         keep[1:] = np.diff(t_ns[order]) > 0
@@ -103,7 +115,8 @@ class Trajectory:
         return cls(t_ns[idx] - int(origin_ns), q[idx] / norm[idx, None], w[idx], tau[idx],
                    as_inertia(inertia), int(origin_ns), title, dropped,
                    wheels if has else None, speeds[idx] if has else None,
-                   motors[idx] if has else None)
+                   motors[idx] if has else None, r[idx] if orbit else None,
+                   v[idx] if orbit else None)
 
     @classmethod
     def from_seconds(cls, t, q, omega, inertia, torque=None, title=''):
@@ -144,7 +157,9 @@ class Trajectory:
         return Trajectory(self.t_ns[keep], self.q[keep], self.omega[keep], self.torque[keep],
                           self.inertia, self.origin_ns, self.title, self.dropped, self.wheels,
                           None if self.wheels is None else self.wheel_speeds[keep],
-                          None if self.wheels is None else self.motor_torques[keep])
+                          None if self.wheels is None else self.motor_torques[keep],
+                          None if self.position is None else self.position[keep],
+                          None if self.velocity is None else self.velocity[keep])
 
     def principal(self):
         """(moments, q, omega, torque) in the principal frame of the inertia."""
@@ -153,9 +168,12 @@ class Trajectory:
                 body.to_principal(self.omega), body.to_principal(self.torque))
 
 
-def analyse(trajectory, baseline=None, tolerances=Tolerances()):
+def analyse(trajectory, baseline=None, tolerances=Tolerances(), gravity_gradient=False):
     """
     Analyse ``trajectory``: conservation, precession, stability against theory.
+
+    With ``gravity_gradient`` and the trajectory's position and velocity, also the
+    libration about LVLH and the Jacobi integral of a circular orbit (``orbit``).
 
     ``baseline`` (optional) is the (t_ns, q, omega) sample free-motion drift
     is measured from, in the trajectory's frames and time origin: the first
@@ -196,10 +214,93 @@ def analyse(trajectory, baseline=None, tolerances=Tolerances()):
     else:
         precession = _precession(t, q, w, moments, trajectory.inertia, tol)
         stability = _stability(t, w, moments, trajectory.inertia, tol, precession=precession)
+    orbit = None
+    if gravity_gradient and trajectory.position is not None:
+        orbit = _orbit(trajectory, moments, q, w, tol)
     return Findings(n, trajectory.span, conservation, precession, stability,
                     kinetic_energy=float(equations.kinetic_energy(moments, w[-1])),
                     angular_momentum_norm=float(np.linalg.norm(moments * w[-1])),
-                    under_torque=under_torque)
+                    under_torque=under_torque, orbit=orbit)
+
+
+#: Largest angle (rad) from LVLH for which the libration frequencies are measured.
+LIBRATION_ANGLE = 0.2
+#: Largest |r . v| / (|r| |v|) of an orbit taken as circular.
+CIRCULAR = 1e-6
+#: At most this many samples go into the frequency estimate (the window is decimated).
+LIBRATION_SAMPLES = 3000
+
+
+def _orbit(trajectory, moments, q, w, tol):
+    """
+    Libration about LVLH and the Jacobi integral of a circular orbit (principal-frame q, w).
+
+    The principal axes are matched to LVLH roll, pitch and yaw by the axis permutation
+    nearest the attitude at the window's start, so any principal axis may be the one
+    along nadir; the frequencies are measured by ESPRIT on the angles from LVLH.
+    """
+    from scipy.spatial.transform import Rotation
+    r, v = trajectory.position, trajectory.velocity
+    rn, vn = np.linalg.norm(r, axis=1), np.linalg.norm(v, axis=1)
+    if not (np.all(rn > 0.0) and np.all(vn > 0.0)):
+        return OrbitFindings(UNAVAILABLE, 'no orbit in the odometry (position or velocity 0)',
+                             UNAVAILABLE)
+    radial = float(np.max(np.abs(np.sum(r * v, axis=1)) / (rn * vn)))
+    if radial > CIRCULAR:
+        return OrbitFindings(UNAVAILABLE, f'the orbit is not circular (radial velocity up to '
+                             f'{radial:.1e} of the speed): the libration theory and the Jacobi '
+                             'integral are for a circular orbit', UNAVAILABLE)
+    h = np.cross(r, v)
+    hn = np.linalg.norm(h, axis=1)
+    n = float(np.mean(hn / (rn * rn)))
+    lvlh = Rotation.from_matrix(np.stack([np.cross(-h / hn[:, None], -r / rn[:, None]),
+                                          -h / hn[:, None], -r / rn[:, None]], axis=2))
+    body = Rotation.from_quat(q)
+    # the Jacobi integral, in the principal frame
+    energy = jacobi_integral(moments, n, w, body.inv().apply(h / hn[:, None]),
+                             body.inv().apply(r / rn[:, None]))
+    scale = max(abs(energy[0]), 1e-300)
+    drift = float(np.max(np.abs(energy - energy[0])) / scale)
+    jacobi_status = level(drift / tol.energy)
+    # the axis permutation P nearest the start: LVLH axis i = principal axis axes[i]
+    rel = lvlh.inv() * body
+    cube = Rotation.create_group('O')
+    p = cube[int(np.argmin((cube * rel[0].inv()).magnitude()))]
+    perm = np.rint(p.as_matrix())                  # rel ~ P: LVLH <- principal
+    axes = tuple(int(np.argmax(np.abs(row))) for row in perm)
+    angles = (rel * p.inv()).as_rotvec()           # roll, pitch, yaw from LVLH (rad)
+    largest = float(np.max(np.abs(angles)))
+    theory = libration_modes(np.abs(perm) @ moments, n)
+    slow, fast = theory.roll_yaw if theory.roll_yaw is not None else (None, None)
+    t = trajectory.t
+    span = t[-1] - t[0] if t.size > 1 else 0.0
+    known = [f for f in (theory.pitch, slow) if f]
+    need = 1.5 * 2 * math.pi / min(known) if known else math.inf
+    why = ''
+    if largest > LIBRATION_ANGLE:
+        why = (f'{largest:.3g} rad from LVLH (beyond {LIBRATION_ANGLE:g}): the small-angle '
+               'theory does not apply')
+    elif span < need:
+        why = f'need {need:.6g} s of data (1.5 periods of the slowest libration), have {span:.6g}'
+    if why:
+        pitch = unavailable(why, theory.pitch, 'rad/s')
+        roll_slow, roll_fast = unavailable(why, slow, 'rad/s'), unavailable(why, fast, 'rad/s')
+    else:
+        grid = np.linspace(t[0], t[-1], min(t.size, LIBRATION_SAMPLES))
+        uniform = np.stack([np.interp(grid, t, angles[:, k]) for k in range(3)])
+        measured_pitch = oscillation_frequencies(grid, uniform[1], 1)
+        measured_roll = oscillation_frequencies(grid, uniform[[0, 2]], 2)
+        pitch = compare(None if measured_pitch is None else measured_pitch[0], theory.pitch,
+                        tol.libration, 'rad/s')
+        roll_slow, roll_fast = (compare(None if measured_roll is None else measured_roll[k],
+                                        mode, tol.libration, 'rad/s')
+                                for k, mode in enumerate((slow, fast)))
+    status = worst(jacobi_status, pitch.status, roll_slow.status, roll_fast.status)
+    verdict = ('stable' if theory.stable else 'unstable') + f' ({theory.region} region)'
+    message = (f'gravity-gradient libration about LVLH, {verdict}; Jacobi integral drift '
+               f'{drift:.1e}')
+    return OrbitFindings(status, message, 'libration', n, axes, pitch, roll_slow, roll_fast,
+                         theory.region, largest, drift, tol.energy)
 
 
 def _gyrostat(trajectory, t, w, under_torque, tol):

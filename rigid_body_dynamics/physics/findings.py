@@ -117,8 +117,36 @@ class StabilityFindings:
 
 
 @dataclass(frozen=True)
+class OrbitFindings:
+    """
+    A body under the gravity gradient in a circular orbit: libration about LVLH, Jacobi drift.
+
+    ``kind``: 'libration' or 'unavailable'. ``orbit_rate`` n (rad/s, from the odometry's
+    position and velocity); ``axes`` the principal axes (0-based) along LVLH roll, pitch,
+    yaw; ``pitch``, ``roll_yaw_slow``, ``roll_yaw_fast`` (Quantity, rad/s): the measured
+    libration frequencies against the theory of
+    :func:`~.environment.libration.libration_modes`; ``region`` 'Lagrange',
+    'DeBra-Delp' or 'unstable'; ``largest_angle`` (rad) from LVLH over the window;
+    ``jacobi_drift`` the largest |E - E0| / |E0| of the Jacobi integral.
+    """
+
+    status: str
+    message: str
+    kind: str
+    orbit_rate: object = None
+    axes: object = None
+    pitch: Quantity = None
+    roll_yaw_slow: Quantity = None
+    roll_yaw_fast: Quantity = None
+    region: str = ''
+    largest_angle: object = None
+    jacobi_drift: object = None
+    jacobi_tolerance: float = math.nan
+
+
+@dataclass(frozen=True)
 class Findings:
-    """Everything :func:`analyse` says about a trajectory."""
+    """Everything :func:`analyse` says about a trajectory (``orbit`` with an orbit)."""
 
     samples: int
     span: float
@@ -128,6 +156,7 @@ class Findings:
     kinetic_energy: object = None
     angular_momentum_norm: object = None
     under_torque: bool = False
+    orbit: object = None
 
     def to_dict(self):
         """Return the JSON form (``rigid_body_analyze --json``): numbers, None where n/a."""
@@ -161,6 +190,16 @@ class Findings:
                              **quantity('growth_rate', s.growth_rate),
                              **quantity('flip_interval', s.flip_interval),
                              **quantity('wobble_frequency', s.wobble_frequency)}}
+        o = self.orbit
+        if o is not None:
+            out['orbit'] = {'status': o.status, 'kind': o.kind, 'message': o.message,
+                            'orbit_rate': num(o.orbit_rate), 'region': o.region or None,
+                            'axes': None if o.axes is None else [a + 1 for a in o.axes],
+                            'largest_angle': num(o.largest_angle),
+                            'jacobi_drift': num(o.jacobi_drift),
+                            **quantity('pitch', o.pitch),
+                            **quantity('roll_yaw_slow', o.roll_yaw_slow),
+                            **quantity('roll_yaw_fast', o.roll_yaw_fast)}
         return out
 
     def lines(self):

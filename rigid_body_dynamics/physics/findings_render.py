@@ -17,8 +17,8 @@ that is not available ``<label>, measured (<unit>)`` = ``not available: <why>``.
 
 import math
 
-from .findings import (ConservationFindings, Findings, OK, PrecessionFindings, Quantity,
-                       StabilityFindings, UNAVAILABLE)
+from .findings import (ConservationFindings, Findings, OK, OrbitFindings, PrecessionFindings,
+                       Quantity, StabilityFindings, UNAVAILABLE)
 
 #: The quantities of the findings: (section, field, diagnostics label, text label). The unit
 #: is the quantity's own; ``{axis}`` is the circled axis (1-based).
@@ -31,11 +31,15 @@ QUANTITIES = (
     ('stability', 'growth_rate', 'growth rate', 'growth rate'),
     ('stability', 'flip_interval', 'flip interval', 'flip interval'),
     ('stability', 'wobble_frequency', 'wobble frequency', 'wobble frequency'),
+    ('orbit', 'pitch', 'pitch libration frequency', 'pitch libration'),
+    ('orbit', 'roll_yaw_slow', 'roll-yaw libration frequency, slow', 'roll-yaw libration, slow'),
+    ('orbit', 'roll_yaw_fast', 'roll-yaw libration frequency, fast', 'roll-yaw libration, fast'),
 )
 #: The unit each quantity is written with.
 UNITS = {'body_rate': 'rad/s', 'lab_rate': 'rad/s', 'omega_period': 's',
          'mean_precession': 'rad/s', 'growth_rate': '1/s', 'flip_interval': 's',
-         'wobble_frequency': 'rad/s'}
+         'wobble_frequency': 'rad/s', 'pitch': 'rad/s', 'roll_yaw_slow': 'rad/s',
+         'roll_yaw_fast': 'rad/s'}
 #: Conservation values: (mode, field, key).
 CONSERVATION = (
     ('free motion', 'energy_drift', 'energy drift since baseline (rel.)'),
@@ -72,6 +76,15 @@ OTHER_KEYS = (
     ('stability', 'polhode family', 'as in precession'),
     ('stability', 'separatrix distance (S/G^2)', 'distance of the polhode from the separatrix'),
     ('stability', 'wobble frequency (rad/s)', "the wobble frequency's theory (older key)"),
+    ('orbit', 'kind', '`libration` (gravity gradient, circular orbit) or `unavailable`'),
+    ('orbit', 'orbit rate (rad/s)', "n, from the odometry's position and velocity"),
+    ('orbit', 'principal axes along roll, pitch, yaw', 'which principal axes (1-3) are '
+     'along LVLH x, y, z'),
+    ('orbit', 'stability region', "`Lagrange`, `DeBra-Delp` or `unstable` (the theory's "
+     'verdict)'),
+    ('orbit', 'largest angle from LVLH (rad)', 'over the window'),
+    ('orbit', 'Jacobi integral drift (rel.)', 'largest |E - E0| / |E0| over the window'),
+    ('orbit', 'Jacobi tolerance', 'the tolerance it was checked against (the energy one)'),
 )
 #: What each quantity is, for the manual.
 MEANINGS = {
@@ -83,6 +96,9 @@ MEANINGS = {
     'growth_rate': 'unstable spin: growth rate of a small departure',
     'flip_interval': 'unstable spin: time between flips',
     'wobble_frequency': 'stable spin: 2 pi / period of omega',
+    'pitch': 'gravity-gradient pitch libration about LVLH, n sqrt(3 (Ix - Iz) / Iy) by theory',
+    'roll_yaw_slow': 'the slower root of the roll-yaw libration (Wie, section 6.3)',
+    'roll_yaw_fast': 'the faster root of the roll-yaw libration',
 }
 
 
@@ -98,7 +114,7 @@ def reference_rows():
              for mode, field, key in CONSERVATION]
     rows += [(sec, key, meaning) for sec, key, meaning in OTHER_KEYS
              if sec == 'conservation' and key not in ('mode', 'baseline stamp (s)')]
-    for section in ('precession', 'stability'):
+    for section in ('precession', 'stability', 'orbit'):
         rows += [(sec, key, meaning) for sec, key, meaning in OTHER_KEYS if sec == section]
         for sec, field, key, _text in QUANTITIES:
             if sec != section:
@@ -183,7 +199,18 @@ def text_lines(found):
             if section == wanted:
                 out += quantity_lines(_labels(section, field, getattr(found, section))[1], qty)
     out.append(conservation_line(found.conservation))
+    o = found.orbit
+    if o is not None:
+        out.append(f'  orbit: {o.message}')
+        for field, qty in _orbit_quantities(o):
+            out += quantity_lines(_labels('orbit', field, o)[1], qty)
     return out
+
+
+def _orbit_quantities(o):
+    """Return the (field, Quantity) entries of :class:`~.findings.OrbitFindings` it has."""
+    return [(field, getattr(o, field)) for field in ('pitch', 'roll_yaw_slow', 'roll_yaw_fast')
+            if getattr(o, field) is not None]
 
 
 def table_rows(found):
@@ -216,6 +243,10 @@ def table_rows(found):
     if s.axis is not None:
         rows.append(('stability of the spin', s.kind, f'axis {s.axis + 1}'))
     rows += [row(*e) for e in shown if e[0] == 'stability']
+    o = found.orbit
+    if o is not None and o.kind != UNAVAILABLE:
+        rows.append(('Jacobi integral drift (rel.)', f'{o.jacobi_drift:.2e}', '0'))
+        rows += [row('orbit', field, qty) for field, qty in _orbit_quantities(o)]
     return rows
 
 
@@ -272,9 +303,24 @@ def key_values(found, origin_ns=0):
             values += [('body cone half-angle (rad)', p.cones.body),
                        ('lab cone half-angle (rad)', p.cones.lab),
                        ('nutation angle (rad)', p.cones.nutation)]
-    return {'conservation': (c.status, c.message, cons),
-            'precession': (p.status, p.message, pre),
-            'stability': (s.status, s.message, stab if s.axis is not None else [])}
+    out = {'conservation': (c.status, c.message, cons),
+           'precession': (p.status, p.message, pre),
+           'stability': (s.status, s.message, stab if s.axis is not None else [])}
+    o = found.orbit
+    if o is not None:
+        values = [('kind', o.kind)]
+        if o.kind != UNAVAILABLE:
+            values += [('orbit rate (rad/s)', o.orbit_rate),
+                       ('principal axes along roll, pitch, yaw', ' '.join(
+                           str(a + 1) for a in o.axes)),
+                       ('stability region', o.region),
+                       ('largest angle from LVLH (rad)', o.largest_angle),
+                       ('Jacobi integral drift (rel.)', o.jacobi_drift),
+                       ('Jacobi tolerance', o.jacobi_tolerance)]
+            for field, qty in _orbit_quantities(o):
+                values += quantity_values(_labels('orbit', field, o)[0], qty)
+        out['orbit'] = (o.status, o.message, values)
+    return out
 
 
 def _shown_all(found):
@@ -347,4 +393,18 @@ def from_key_values(sections, samples=0, span=math.nan):
         separatrix_distance=_or_nan(_number(sv.get('separatrix distance (S/G^2)'))),
         wobble_frequency=found['wobble_frequency'], growth_rate=found['growth_rate'],
         flip_interval=found['flip_interval'])
-    return Findings(samples, span, conservation, precession, stability)
+    orbit = None
+    if 'orbit' in sections:
+        o_status, o_message, ov = section('orbit')
+        quantities = {field: _quantity_from(ov, _labels('orbit', field, None)[0], 'rad/s')
+                      for field in ('pitch', 'roll_yaw_slow', 'roll_yaw_fast')}
+        axes = ov.get('principal axes along roll, pitch, yaw')
+        orbit = OrbitFindings(
+            o_status, o_message, ov.get('kind', UNAVAILABLE),
+            orbit_rate=_number(ov.get('orbit rate (rad/s)')),
+            axes=None if not axes else tuple(int(a) - 1 for a in str(axes).split()),
+            region=ov.get('stability region', ''),
+            largest_angle=_number(ov.get('largest angle from LVLH (rad)')),
+            jacobi_drift=_number(ov.get('Jacobi integral drift (rel.)')),
+            jacobi_tolerance=_or_nan(_number(ov.get('Jacobi tolerance'))), **quantities)
+    return Findings(samples, span, conservation, precession, stability, orbit=orbit)

@@ -25,7 +25,9 @@ class Tolerances:
     change). ``rate``: measured against predicted rates and periods of the
     free motion. ``growth``: the measured growth rate near the intermediate
     axis against the linearised prediction (finite amplitudes differ by
-    about 1e-4). ``min_samples``: fewer samples give no estimate.
+    about 1e-4). ``libration``: measured gravity-gradient libration frequencies
+    against the small-angle theory (finite amplitudes differ by about the
+    squared angle). ``min_samples``: fewer samples give no estimate.
     """
 
     energy: float = 1e-6
@@ -33,11 +35,12 @@ class Tolerances:
     balance: float = 1e-2
     rate: float = 1e-6
     growth: float = 1e-2
+    libration: float = 1e-3
     min_samples: int = 20
 
     def __post_init__(self):
         """Refuse a tolerance that is not a positive number: 0 switched its check off."""
-        for name in ('energy', 'momentum', 'balance', 'rate', 'growth'):
+        for name in ('energy', 'momentum', 'balance', 'rate', 'growth', 'libration'):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) \
                     or not math.isfinite(value) or value <= 0.0:
