@@ -237,7 +237,8 @@ def _orbit(trajectory, moments, q, w, tol):
 
     The principal axes are matched to LVLH roll, pitch and yaw by the axis permutation
     nearest the attitude at the window's start, so any principal axis may be the one
-    along nadir; the frequencies are measured by ESPRIT on the angles from LVLH.
+    along nadir (the theory takes the moments along roll, pitch, yaw); the frequencies
+    are measured by ESPRIT on the angles from LVLH.
     """
     from scipy.spatial.transform import Rotation
     r, v = trajectory.position, trajectory.velocity
@@ -266,11 +267,10 @@ def _orbit(trajectory, moments, q, w, tol):
     rel = lvlh.inv() * body
     cube = Rotation.create_group('O')
     p = cube[int(np.argmin((cube * rel[0].inv()).magnitude()))]
-    perm = np.rint(p.as_matrix())                  # rel ~ P: LVLH <- principal
-    axes = tuple(int(np.argmax(np.abs(row))) for row in perm)
+    along = tuple(float(m) for m in np.abs(np.rint(p.as_matrix())) @ moments)  # I_x, I_y, I_z
     angles = (rel * p.inv()).as_rotvec()           # roll, pitch, yaw from LVLH (rad)
     largest = float(np.max(np.abs(angles)))
-    theory = libration_modes(np.abs(perm) @ moments, n)
+    theory = libration_modes(along, n)
     slow, fast = theory.roll_yaw if theory.roll_yaw is not None else (None, None)
     t = trajectory.t
     span = t[-1] - t[0] if t.size > 1 else 0.0
@@ -299,7 +299,7 @@ def _orbit(trajectory, moments, q, w, tol):
     verdict = ('stable' if theory.stable else 'unstable') + f' ({theory.region} region)'
     message = (f'gravity-gradient libration about LVLH, {verdict}; Jacobi integral drift '
                f'{drift:.1e}')
-    return OrbitFindings(status, message, 'libration', n, axes, pitch, roll_slow, roll_fast,
+    return OrbitFindings(status, message, 'libration', n, along, pitch, roll_slow, roll_fast,
                          theory.region, largest, drift, tol.energy)
 
 

@@ -122,8 +122,9 @@ class OrbitFindings:
     A body under the gravity gradient in a circular orbit: libration about LVLH, Jacobi drift.
 
     ``kind``: 'libration' or 'unavailable'. ``orbit_rate`` n (rad/s, from the odometry's
-    position and velocity); ``axes`` the principal axes (0-based) along LVLH roll, pitch,
-    yaw; ``pitch``, ``roll_yaw_slow``, ``roll_yaw_fast`` (Quantity, rad/s): the measured
+    position and velocity); ``moments`` the principal moments (kg m^2) along LVLH roll,
+    pitch and yaw (I_x, I_y, I_z of the theory); ``pitch``, ``roll_yaw_slow``,
+    ``roll_yaw_fast`` (Quantity, rad/s): the measured
     libration frequencies against the theory of
     :func:`~.environment.libration.libration_modes`; ``region`` 'Lagrange',
     'DeBra-Delp' or 'unstable'; ``largest_angle`` (rad) from LVLH over the window;
@@ -134,7 +135,7 @@ class OrbitFindings:
     message: str
     kind: str
     orbit_rate: object = None
-    axes: object = None
+    moments: object = None
     pitch: Quantity = None
     roll_yaw_slow: Quantity = None
     roll_yaw_fast: Quantity = None
@@ -194,7 +195,7 @@ class Findings:
         if o is not None:
             out['orbit'] = {'status': o.status, 'kind': o.kind, 'message': o.message,
                             'orbit_rate': num(o.orbit_rate), 'region': o.region or None,
-                            'axes': None if o.axes is None else [a + 1 for a in o.axes],
+                            'moments': None if o.moments is None else list(o.moments),
                             'largest_angle': num(o.largest_angle),
                             'jacobi_drift': num(o.jacobi_drift),
                             **quantity('pitch', o.pitch),

@@ -78,8 +78,8 @@ OTHER_KEYS = (
     ('stability', 'wobble frequency (rad/s)', "the wobble frequency's theory (older key)"),
     ('orbit', 'kind', '`libration` (gravity gradient, circular orbit) or `unavailable`'),
     ('orbit', 'orbit rate (rad/s)', "n, from the odometry's position and velocity"),
-    ('orbit', 'principal axes along roll, pitch, yaw', 'which principal axes (1-3) are '
-     'along LVLH x, y, z'),
+    ('orbit', 'moments along roll, pitch, yaw (kg m^2)', 'the principal moments along LVLH '
+     "x, y, z at the window's start: I_x, I_y, I_z of the theory"),
     ('orbit', 'stability region', "`Lagrange`, `DeBra-Delp` or `unstable` (the theory's "
      'verdict)'),
     ('orbit', 'largest angle from LVLH (rad)', 'over the window'),
@@ -311,8 +311,8 @@ def key_values(found, origin_ns=0):
         values = [('kind', o.kind)]
         if o.kind != UNAVAILABLE:
             values += [('orbit rate (rad/s)', o.orbit_rate),
-                       ('principal axes along roll, pitch, yaw', ' '.join(
-                           str(a + 1) for a in o.axes)),
+                       ('moments along roll, pitch, yaw (kg m^2)', ' '.join(
+                           f'{m:.10g}' for m in o.moments)),
                        ('stability region', o.region),
                        ('largest angle from LVLH (rad)', o.largest_angle),
                        ('Jacobi integral drift (rel.)', o.jacobi_drift),
@@ -398,11 +398,11 @@ def from_key_values(sections, samples=0, span=math.nan):
         o_status, o_message, ov = section('orbit')
         quantities = {field: _quantity_from(ov, _labels('orbit', field, None)[0], 'rad/s')
                       for field in ('pitch', 'roll_yaw_slow', 'roll_yaw_fast')}
-        axes = ov.get('principal axes along roll, pitch, yaw')
+        along = ov.get('moments along roll, pitch, yaw (kg m^2)')
         orbit = OrbitFindings(
             o_status, o_message, ov.get('kind', UNAVAILABLE),
             orbit_rate=_number(ov.get('orbit rate (rad/s)')),
-            axes=None if not axes else tuple(int(a) - 1 for a in str(axes).split()),
+            moments=None if not along else tuple(float(m) for m in str(along).split()),
             region=ov.get('stability region', ''),
             largest_angle=_number(ov.get('largest angle from LVLH (rad)')),
             jacobi_drift=_number(ov.get('Jacobi integral drift (rel.)')),
