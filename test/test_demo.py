@@ -74,3 +74,35 @@ def test_demo_wheels_scene_in_lockstep_and_offline():
         found[args[-1]] = (low, high, peak, after)
     lockstep, offline = found['wheels'], found['--offline']
     assert all(abs(a - b) < 1e-3 for a, b in zip(lockstep, offline)), found
+
+
+def test_demo_satellite_scene_in_lockstep_and_offline():
+    """
+    The fifth scene, on the nodes and offline: the same lines, bit for bit.
+
+    B-dot takes the CubeSat from 10 deg/s below 0.5 deg/s within one orbit (3719 s).
+    """
+    found = {}
+    for args in (('--preset', 'satellite'), ('--preset', 'satellite', '--offline')):
+        out = _demo(*args)
+        assert out.returncode == 0, out.stderr
+        assert '--offline' in args or 'exit codes 0, 0' in out.stdout
+        lines = [line for line in out.stdout.splitlines() if line.startswith('  ')]
+        found[args[-1]] = lines[:2]
+        reached = re.search(r'0.5 deg/s after (\d+) s', lines[0])
+        assert reached and float(reached.group(1)) < 5677.0, lines
+    assert found['satellite'] == found['--offline']
+
+
+def test_the_manuals_satellite_yaml_is_the_demos_scene():
+    """doc/examples/satellite.yaml says what the demo's satellite scene runs."""
+    import os
+    import yaml
+    from rigid_body_dynamics.tools.demo import _satellite_parameters
+    path = os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples', 'satellite.yaml')
+    with open(path) as f:
+        config = yaml.safe_load(f)
+    shared, sim, ctl = _satellite_parameters()
+    assert config['/**']['ros__parameters'] == shared
+    assert config['/**/attitude_simulator']['ros__parameters'] == sim
+    assert config['/**/attitude_controller']['ros__parameters'] == ctl

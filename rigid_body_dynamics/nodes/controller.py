@@ -191,6 +191,8 @@ class AttitudeController(Node):
                                      v['max_torque'])
 
     def _on_inertia(self, msg):
+        if self._bdot:          # B-dot needs no inertia; a new law would forget its last reading
+            return
         i = msg.inertia
         moments = (i.ixx, i.iyy, i.izz)      # the body axes' moments (the diagonal)
         if not all(m > 0.0 and math.isfinite(m) for m in moments):

@@ -124,8 +124,9 @@ class BDot:
         m = [k * (b[i] - last[1][i]) for i in range(3)]
         scale = max([abs(c) / top for c, top in zip(m, self.max_dipole) if top > 0.0],
                     default=0.0)
-        if scale > 1.0:
-            m = [c / scale for c in m]
+        if scale > 1.0:           # (clamped too: c / scale may round past the limit)
+            m = [min(max(c / scale, -top), top) if top > 0.0 else c / scale
+                 for c, top in zip(m, self.max_dipole)]
         return tuple(m)
 
 

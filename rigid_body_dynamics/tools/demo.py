@@ -11,7 +11,9 @@ then the closed loop: ``attitude_controller`` slewing the default body at
 rest to a target in lockstep, its settling time against the PD theory and
 the pointing error at the end; then the same body flown by four reaction
 wheels against a disturbance, the wheels spinning up and unloading their
-momentum. ``--offline`` measures the same straight from the physics layer,
+momentum; then a 3U CubeSat in a polar orbit detumbled by B-dot with
+magnetorquers (``--preset satellite``, the manual's ``satellite.yaml``).
+``--offline`` measures the same straight from the physics layer and the engine,
 without ROS.
 """
 
@@ -45,6 +47,144 @@ WHEEL_SCENE = {'target': (math.sin(math.radians(7.5)), 0.0, 0.0, math.cos(math.r
                           'wheel_max_torque': [0.2] * 4, 'wheel_max_speed': [30.0] * 4,
                           'wheel_friction_coulomb': [1e-4] * 4,
                           'wheel_friction_viscous': [1e-6] * 4}}
+
+
+#: The satellite scene (doc/examples/satellite.yaml has the same values; the suite checks):
+#: a 3U CubeSat tumbling at 10 deg/s in a 500 km circular polar orbit, B-dot at 1 Hz.
+SATELLITE = 'satellite'
+SATELLITE_SCENE = {
+    'inertia': [0.033, 0.033, 0.007],
+    'orbit_elements': [6878137.0, 0.0, math.pi / 2, 0.0, 0.0, 0.0],
+    'initial_angular_velocity': [0.10077, 0.10077, 0.10077],
+    'magnetorquer_max_dipole': [0.2, 0.2, 0.2], 'bdot_gain': 1e5,
+    'integration_rate': 10.0, 'control_period': 1.0, 'target_rate': math.radians(0.5),
+}
+
+
+def _satellite_parameters():
+    """The scene as node parameters: (shared by all nodes, the simulator's, the controller's)."""
+    s = SATELLITE_SCENE
+    shared = {'inertia': s['inertia'], 'orbit_elements': s['orbit_elements'],
+              'gravity_gradient': True, 'magnetic_field_model': 'dipole',
+              'magnetorquer_max_dipole': s['magnetorquer_max_dipole']}
+    sim = {'initial_angular_velocity': s['initial_angular_velocity'],
+           'integration_rate': s['integration_rate'], 'publish_rate': 1.0 / s['control_period'],
+           'publish_clock': True, 'magnetometer_rate': 1.0 / s['control_period'],
+           'lockstep': True, 'control_period': s['control_period'],
+           'lockstep_answer': 'magnetorquer_cmd'}
+    ctl = {'mode': 'bdot', 'actuator': 'magnetorquers', 'bdot_gain': s['bdot_gain']}
+    return shared, sim, ctl
+
+
+def satellite_lines(t, rates, dipoles, how):
+    """Lines about the satellite scene: when |omega| passed 5, 1 and 0.5 deg/s; rod saturation."""
+    from ..physics.environment import KeplerOrbit
+    s = SATELLITE_SCENE
+    orbit = KeplerOrbit(s['orbit_elements'])
+    deg = np.degrees(np.asarray(rates))
+    below = {}
+    for level in (5.0, 1.0, math.degrees(s['target_rate'])):
+        hit = np.flatnonzero(deg <= level + 1e-12)
+        below[level] = t[hit[0]] if hit.size else None
+    limit = s['magnetorquer_max_dipole'][0]
+    full = np.flatnonzero([max(abs(c) for c in m) >= limit * (1 - 1e-12) for m in dipoles])
+    saturated = t[full[-1]] if full.size else 0.0
+    reached = below[math.degrees(s['target_rate'])]
+    return [f'{SATELLITE}: B-dot detumbles a 3U CubeSat (I = {tuple(s["inertia"])} kg m^2) '
+            f'from {deg[0]:.2f} deg/s in a {(orbit.a - 6378137.0) / 1e3:.0f} km circular polar '
+            f'orbit ({orbit.period / 60:.1f} min), k = {s["bdot_gain"]:g} A m^2 s/T every '
+            f'{s["control_period"]:g} s, {limit:g} A m^2 rods, {how}:',
+            '  |omega| below ' + ', '.join(
+                f'{level:g} deg/s after {"never" if at is None else f"{at:.0f} s"}'
+                for level, at in below.items()),
+            f'  target {math.degrees(s["target_rate"]):g} deg/s reached '
+            + ('not within the run' if reached is None else
+               f'after {reached / orbit.period:.2f} orbit') +
+            f'; the rods were at their limit until {saturated:.0f} s']
+
+
+def _satellite_body():
+    """The satellite scene's body on the engine, with its magnetometer and magnetorquers."""
+    from ..engine import BodySimulation, Disturbances
+    from ..physics import Inertia
+    from ..physics.environment import DipoleField, KeplerOrbit
+    s = SATELLITE_SCENE
+    every = round(s['integration_rate'] * s['control_period'])
+    return BodySimulation(
+        Inertia(s['inertia']), 'exact', s['integration_rate'],
+        ((0.0, 0.0, 0.0, 1.0), tuple(s['initial_angular_velocity'])), torque_timeout=0.0,
+        publish_every=every, disturbances=Disturbances(
+            orbit=KeplerOrbit(s['orbit_elements']), field=DipoleField(), gravity_gradient=True),
+        magnetorquers=tuple(s['magnetorquer_max_dipole']),
+        magnetometer=(0.0, (0.0, 0.0, 0.0)), magnetometer_every=every)
+
+
+def satellite_offline():
+    """Run the satellite scene on the engine without ROS (engine.offline.detumble)."""
+    from ..engine.offline import detumble
+    from ..physics.control import BDot
+    s = SATELLITE_SCENE
+    run = detumble(_satellite_body(), BDot(s['bdot_gain'], s['magnetorquer_max_dipole']),
+                   5700.0, s['target_rate'])
+    return satellite_lines(np.array(run['times']), run['rates'], run['dipoles'], 'offline')
+
+
+def run_satellite():
+    """Run the satellite scene on the nodes: the simulator in lockstep and B-dot."""
+    import tempfile
+
+    from geometry_msgs.msg import Vector3Stamped
+    from nav_msgs.msg import Odometry
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    import yaml
+
+    from ..ros.client import interrupt, RosClient, start_node
+    from ..ros.conversions import time_ns
+    shared, sim_params, ctl_params = _satellite_parameters()
+    with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
+        yaml.safe_dump({'/**': {'ros__parameters': shared},
+                        '/**/attitude_simulator': {'ros__parameters': sim_params},
+                        '/**/attitude_controller': {'ros__parameters': ctl_params}}, f)
+        params = f.name
+    quiet = ['--log-level', 'warn', '--params-file', params]
+    sim, ctl = start_node('simulator', list(quiet) + [
+        '-p', 'qos_overrides./odom.publisher.depth:=10000',
+        '-p', 'qos_overrides./applied_dipole.publisher.depth:=10000']), None
+    rates, dipoles = {}, {}
+    deep = QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE)
+    client = RosClient('rigid_body_demo')
+    target = SATELLITE_SCENE['target_rate']
+    try:
+        node = client.node
+        node.create_subscription(Odometry, 'odom', lambda m: rates.setdefault(
+            time_ns(m.header.stamp), math.sqrt(m.twist.twist.angular.x ** 2
+                                               + m.twist.twist.angular.y ** 2
+                                               + m.twist.twist.angular.z ** 2)), deep)
+        # the dipole held over each tick, as the simulator applied it (the controller's own
+        # topic is matched only after it starts, while lockstep may already be running)
+        period = round(SATELLITE_SCENE['control_period'] * 1e9)
+        node.create_subscription(Vector3Stamped, 'applied_dipole', lambda m: dipoles.setdefault(
+            time_ns(m.header.stamp) - period, (m.vector.x, m.vector.y, m.vector.z)), deep)
+        client.spin_until(lambda: rates and node.count_publishers('applied_dipole'), 30.0,
+                          'the first state of attitude_simulator')
+        ctl = start_node('controller', list(quiet))
+        print(f'{SATELLITE}: started attitude_simulator in orbit, in lockstep (pid {sim.pid}), '
+              f'and attitude_controller flying B-dot (pid {ctl.pid}) ...', flush=True)
+
+        def done():
+            stamps = sorted(rates)
+            return stamps[-1] >= 5700e9 or (rates[stamps[-1]] <= target and
+                                            stamps[-1] in dipoles)
+        client.spin_until(done, 300.0, 'the CubeSat to detumble')
+    finally:
+        client.close()
+        codes = [interrupt(proc) for proc in (ctl, sim) if proc is not None]
+        os.unlink(params)
+    stamps = [k for k in sorted(rates) if k in dipoles]
+    return satellite_lines(np.array(stamps) * 1e-9, [rates[k] for k in stamps],
+                           [dipoles[k] for k in stamps], 'in lockstep') + [
+        f'  stopped attitude_controller and attitude_simulator (exit codes '
+        f'{", ".join(str(c) for c in codes)})']
 
 
 def report(preset, integrator, duration, dt):
@@ -368,8 +508,8 @@ def main(argv=None):
     """Console entry point: print theory against simulation (nodes, or --offline)."""
     parser = argparse.ArgumentParser(prog='rigid_body_demo', description=__doc__.splitlines()[1])
     parser.add_argument('--preset', default=None,
-                        help=f'preset name, or {CLOSED_LOOP} or {WHEELS} (default: a tour of '
-                        'all four scenes)')
+                        help=f'preset name, or {CLOSED_LOOP}, {WHEELS} or {SATELLITE} '
+                        '(default: a tour of all five scenes)')
     parser.add_argument('--integrator', default='exact', choices=sorted(INTEGRATORS))
     parser.add_argument('--duration', type=float, default=None,
                         help='simulated seconds (--offline)')
@@ -377,7 +517,7 @@ def main(argv=None):
     parser.add_argument('--offline', action='store_true', help='physics only, no ROS nodes')
     args = parser.parse_args(argv)
     names = [args.preset] if args.preset else ['symmetric_top', 'tennis_racket', CLOSED_LOOP,
-                                               WHEELS]
+                                               WHEELS, SATELLITE]
     reservation = None if args.offline else _ros_environment()
     try:
         for name in names:
@@ -387,6 +527,10 @@ def main(argv=None):
                 continue
             if name == WHEELS:
                 lines = wheels_offline() if args.offline else run_wheels()
+                print('\n'.join(lines), flush=True)
+                continue
+            if name == SATELLITE:
+                lines = satellite_offline() if args.offline else run_satellite()
                 print('\n'.join(lines), flush=True)
                 continue
             body = presets.get(name)
