@@ -62,7 +62,7 @@ SATELLITE_SCENE = {
 
 
 def _satellite_parameters():
-    """The scene as node parameters: (shared by all nodes, the simulator's, the controller's)."""
+    """Return the scene as node parameters: (all nodes, the simulator, the controller)."""
     s = SATELLITE_SCENE
     shared = {'inertia': s['inertia'], 'orbit_elements': s['orbit_elements'],
               'gravity_gradient': True, 'magnetic_field_model': 'dipole',
@@ -104,7 +104,7 @@ def satellite_lines(t, rates, dipoles, how):
 
 
 def _satellite_body():
-    """The satellite scene's body on the engine, with its magnetometer and magnetorquers."""
+    """Build the satellite scene's body on the engine, with magnetometer and magnetorquers."""
     from ..engine import BodySimulation, Disturbances
     from ..physics import Inertia
     from ..physics.environment import DipoleField, KeplerOrbit
