@@ -650,7 +650,7 @@ class BodySimulation:
         Count ``count`` commands of ``kind`` refused before they were held; also an event.
 
         E.g. 'rejected_frame' (the decoder) or 'stale' (lockstep); a dipole
-        command's event is prefixed 'dipole_'. Takes the lock.
+        command's event is prefixed with ``dipole_``. Takes the lock.
         """
         with self.lock:
             if kind == 'dipole':

@@ -29,7 +29,7 @@ the gravity gradient alone in a circular orbit, at any attitude:
 
     E = 1/2 w_r . I w_r - 1/2 n^2 h_B . I h_B + 3/2 n^2 r_B . I r_B,   w_r = omega - n h_B
 
-with h_B the orbit normal (r x v / |r x v|) and r_B the radial unit vector, both in
+with h_B the orbit normal (r x v / norm(r x v)) and r_B the radial unit vector, both in
 the body frame, omega (rad/s) the body's angular velocity in the body frame.
 """
 

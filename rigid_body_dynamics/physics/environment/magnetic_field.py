@@ -4,7 +4,7 @@ Earth's magnetic field as the centred tilted dipole of degree 1 (no ROS).
 In the Earth-fixed frame (z the rotation axis, x through the prime meridian)
 the field at position r (m) is
 
-    B(r) = (R_ref / |r|)^3 [3 (d . r_hat) r_hat - d],   d = (g11, h11, g10)
+    B(r) = (R_ref / norm(r))^3 [3 (d . r_hat) r_hat - d],   d = (g11, h11, g10)
 
 with the Gauss coefficients of degree 1 (nT; B comes out in tesla here),
 R_ref = 6371.2 km the reference radius of the IGRF (International

@@ -13,13 +13,13 @@ solved by Newton's method to round-off at any t (the mean anomaly is reduced
 modulo 2 pi first), then
 
     r_pf = a (cos E - e, sqrt(1 - e^2) sin E, 0)
-    v_pf = sqrt(mu a) / |r| (-sin E, sqrt(1 - e^2) cos E, 0)
+    v_pf = sqrt(mu a) / norm(r) (-sin E, sqrt(1 - e^2) cos E, 0)
 
 in the perifocal frame, turned to the world frame by R3(-RAAN) R1(-i) R3(-argp)
 (Vallado, Fundamentals of Astrodynamics and Applications, section 2.6).
 
 LVLH (local vertical, local horizontal) frame of a position r and velocity v:
-z = -r / |r| (nadir), y = -(r x v) / |r x v| (minus the orbit normal),
+z = -r / norm(r) (nadir), y = -(r x v) / norm(r x v) (minus the orbit normal),
 x = y x z (along the velocity for a circular orbit). LVLH axes are roll (x),
 pitch (y) and yaw (z) in the libration theory (Wie, Space Vehicle Dynamics and
 Control, section 6.3).
@@ -137,7 +137,7 @@ def lvlh_axes(r, v):
     """
     Return the LVLH axes (x, y, z) in the world frame of position r (m) and velocity v (m/s).
 
-    z = -r / |r| (nadir), y = -(r x v) / |r x v|, x = y x z; each a 3-tuple.
+    z = -r / norm(r) (nadir), y = -(r x v) / norm(r x v), x = y x z; each a 3-tuple.
     """
     rn = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
     z = (-r[0] / rn, -r[1] / rn, -r[2] / rn)

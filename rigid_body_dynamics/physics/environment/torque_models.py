@@ -32,7 +32,7 @@ import math
 
 class GravityGradient:
     """
-    The gravity-gradient torque 3 mu / |r|^5 (r_B x I r_B) of a point-mass planet.
+    The gravity-gradient torque 3 mu / norm(r)^5 (r_B x I r_B) of a point-mass planet.
 
     ``moments`` (principal, kg m^2), ``mu`` (m^3/s^2). r_B is the position in the
     principal frame (Wie, Space Vehicle Dynamics and Control, section 6.3;
@@ -47,7 +47,7 @@ class GravityGradient:
         self.mu = float(mu)
 
     def torque(self, t, r, q, omega, env):
-        """Return 3 mu / |r|^5 (r_B x I r_B) (N m, principal frame)."""
+        """Return 3 mu / norm(r)^5 (r_B x I r_B) (N m, principal frame)."""
         rx, ry, rz = env.r_body
         r2 = rx * rx + ry * ry + rz * rz
         k = 3.0 * self.mu / (r2 * r2 * math.sqrt(r2))
