@@ -70,6 +70,15 @@ def basilisk_body(moments, omega0, dt, integrator):
     return sim, craft
 
 
+def basilisk_attitude(craft):
+    """Return (q x-y-z-w body -> world, omega rad/s body) from a Basilisk craft's state."""
+    from Basilisk.utilities import RigidBodyKinematics
+    from scipy.spatial.transform import Rotation
+    msg = craft.scStateOutMsg.read()
+    rot = np.array(RigidBodyKinematics.MRP2C(msg.sigma_BN)).T
+    return tuple(Rotation.from_matrix(rot).as_quat()), tuple(msg.omega_BN_B)
+
+
 def mujoco_run(integrator):
     """Run MuJoCo: free joint, zero gravity, diagonal inertia; qvel[3:6] is the body rate."""
     mujoco, model, data = mujoco_body(MOMENTS, OMEGA0, DT, integrator)

@@ -50,7 +50,8 @@ def main():
                                            'bodies', 'hosts', 'analyzer-memory', 'bag',
                                            'lockstep', 'bodies-asymmetric', 'latency',
                                            'publish', 'flow-batch', 'command-path',
-                                           'simulate-cost', 'wheels', 'wheels-node'],
+                                           'simulate-cost', 'wheels', 'wheels-node',
+                                           'environment', 'environment-node'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -114,6 +115,8 @@ SCALE = {
     'simulate-cost': ('simulate_cost', 'simulate() with a callable torque across the separatrix'),
     'wheels': ('wheels', 'Reaction wheels beside Basilisk'),
     'wheels-node': ('wheels_node', 'attitude_simulator with reaction wheels: CPU'),
+    'environment': ('environment', 'A satellite in orbit beside Basilisk'),
+    'environment-node': ('environment_node', 'attitude_simulator in orbit: CPU'),
 }
 
 

@@ -32,7 +32,7 @@ import time
 
 from common import best_of, fmt
 import numpy as np
-from peers import basilisk_body, mujoco_body
+from peers import basilisk_attitude, basilisk_body, mujoco_body
 from rigid_body_dynamics.physics import make_integrator, quaternions, simulate
 from rigid_body_dynamics.physics.control import QuaternionPD
 from rigid_body_dynamics.physics.reference import zoh_reference
@@ -171,8 +171,7 @@ def run_mujoco(case, dt, integrator='RK4'):
 def run_basilisk(case, dt, integrator='svIntegratorRKF78'):
     """Basilisk hub with an ExtForceTorque effector; the torque set before each hold."""
     from Basilisk.simulation import extForceTorque
-    from Basilisk.utilities import macros, RigidBodyKinematics
-    from scipy.spatial.transform import Rotation
+    from Basilisk.utilities import macros
     moments, omega0, command = CASES[case]
     sim, craft = basilisk_body(moments, omega0, dt, integrator)
     effector = extForceTorque.ExtForceTorque()
@@ -182,23 +181,17 @@ def run_basilisk(case, dt, integrator='svIntegratorRKF78'):
     sim.AddModelToTask('step', craft, None, 2)
     sim.AddModelToTask('step', effector, None, 1)
     sim.InitializeSimulation()
-
-    def state():
-        msg = craft.scStateOutMsg.read()
-        rot = np.array(RigidBodyKinematics.MRP2C(msg.sigma_BN)).T
-        return tuple(Rotation.from_matrix(rot).as_quat()), tuple(msg.omega_BN_B)
-
     effector.extTorquePntB_B = [[0.0], [0.0], [0.0]]
     sim.ConfigureStopTime(0)
     sim.ExecuteSimulation()
-    q, w = state()
+    q, w = basilisk_attitude(craft)
     qs, ws = [q], [w]
     start = time.perf_counter()
     for k in range(STEPS_PER_RUN):
         effector.extTorquePntB_B = [[c] for c in command(k, q, w)]
         sim.ConfigureStopTime(macros.sec2nano((k + 1) * HOLD))
         sim.ExecuteSimulation()
-        q, w = state()
+        q, w = basilisk_attitude(craft)
         qs.append(q)
         ws.append(w)
     return (time.perf_counter() - start) / DURATION, qs, ws
