@@ -110,3 +110,44 @@ def test_an_overloaded_fleet_of_128_bodies_exits_within_5_s_of_sigint(launch, pr
     # 128 bodies in one participant took 7-8 s here (Fast DDS' teardown is quadratic)
     assert seconds < 5.0, proc.output()[-3000:]
     assert '8 DDS participants' in proc.output()
+
+
+def test_a_fleet_body_in_orbit_beside_a_free_one(launch, probe, tmp_path):
+    """
+    Check that the orbit, its torques and the magnetometer are per body in a fleet.
+
+    body1 in a 500 km orbit with the gravity gradient, the field and a magnetometer at
+    10 Hz; body2 free: body1's odom position is Kepler's at its stamps (1e-12 relative),
+    body2's is 0 and it has no magnetic_field topic.
+    """
+    from rigid_body_dynamics.physics.environment import KeplerOrbit
+    from sensor_msgs.msg import MagneticField
+    elements = [6878137.0, 0.001, 1.2, 0.3, 0.0, 0.5]
+    params = tmp_path / 'fleet.yaml'
+    params.write_text(f"""\
+/body1/attitude_simulator:
+  ros__parameters:
+    orbit_elements: {elements}
+    gravity_gradient: true
+    magnetic_field_model: dipole
+    magnetometer_rate: 10.0
+""")
+    launch(FLEET, '--params-file', str(params), '--', '--bodies', '2', name='fleet')
+    odom = {k: probe.subscribe(Odometry, f'/body{k}/odom') for k in (1, 2)}
+    inertia = probe.subscribe(InertiaStamped, '/body1/inertia', LATCHED)
+    field = probe.subscribe(MagneticField, '/body1/magnetic_field')
+    for k in (1, 2):
+        probe.wait_for(f'/body{k}/odom', 20, timeout=30.0)
+    probe.wait_for('/body1/magnetic_field', 5)
+    probe.wait_for('/body1/inertia', 1)
+    start = time_ns(inertia[0].header.stamp)
+    orbit = KeplerOrbit(elements)
+    for msg in odom[1]:
+        r = orbit.position((time_ns(msg.header.stamp) - start) * 1e-9)
+        p = msg.pose.pose.position
+        assert np.linalg.norm(np.subtract((p.x, p.y, p.z), r)) < 1e-12 * np.linalg.norm(r)
+    assert all(m.pose.pose.position.x == 0.0 for m in odom[2])
+    assert 2e-5 < np.linalg.norm([field[-1].magnetic_field.x, field[-1].magnetic_field.y,
+                                  field[-1].magnetic_field.z]) < 6e-5
+    assert not probe.endpoints('pub', 'attitude_simulator', '/body2').get(
+        '/body2/magnetic_field')
