@@ -6,16 +6,22 @@ steps, 100 Hz publishing, real time: free (no orbit), on a 500 km circular orbit
 nothing acting (the exact torque-free flow still serves), with the gravity gradient,
 and with the gravity gradient, the dipole field, a residual dipole and a magnetometer
 at 10 Hz (every stage evaluates the orbit, the field and the torques). CPU is the
-simulator's share of one core over 8 s after 3 s of warm-up, each case twice,
-alternating. ``./dev bench --only environment-node``.
+simulator's share of one core over 8 s after 3 s of warm-up, each case three times,
+alternating. Then the engine's step alone (``BodySimulation.advance`` on a fake clock, the
+least of three runs of 20000 steps), free, under a constant torque, and in the same
+environments. ``./dev bench --only environment-node``.
 """
 
 import statistics
+import time
 
 from diagnostic_msgs.msg import DiagnosticArray
 from nodes import measure_cpu, Probe, sim
+from rigid_body_dynamics.engine import BodySimulation, Disturbances
+from rigid_body_dynamics.physics import Inertia
+from rigid_body_dynamics.physics.environment import DipoleField, KeplerOrbit
 
-ROUNDS = 2
+ROUNDS = 3
 BODY = ('inertia:=[2.0, 3.0, 1.2]', 'initial_angular_velocity:=[0.3, -0.5, 0.8]')
 ORBIT = ('orbit_elements:=[6878137.0, 0.0, 1.0, 0.3, 0.0, 0.0]',)
 
@@ -50,6 +56,32 @@ def measure():
         lines.append(f'| {name} | {", ".join(f"{c:.3f}" for c, _r in runs)} (median '
                      f'{median:.3f}) | {median / base:.1f} | '
                      f'{", ".join(f"{r:.3f}" for _c, r in runs)} |')
+    return lines + [''] + engine_steps()
+
+
+def engine_steps(steps=20000):
+    """Return RESULTS.md lines: the engine's cost per 1 ms step in each environment (us)."""
+    orbit = KeplerOrbit([6878137.0, 0.0, 1.0, 0.3, 0.0, 0.0])
+    cases = {'free body (the exact flow)': Disturbances(),
+             'constant body torque 1e-3 N m': Disturbances(body=(1e-3, 0.0, 0.0)),
+             'in orbit, gravity gradient': Disturbances(orbit=orbit, gravity_gradient=True),
+             'gravity gradient, field, residual dipole': Disturbances(
+                 orbit=orbit, field=DipoleField(), gravity_gradient=True,
+                 residual_dipole=(0.01, -0.02, 0.005))}
+    lines = ['| engine step (1 ms, I = (2, 3, 1.2) kg m^2) | us per step |', '|---|---|']
+    for name, disturbances in cases.items():
+        best = float('inf')
+        for _ in range(3):
+            body = BodySimulation(Inertia((2.0, 3.0, 1.2)), 'exact', 1000.0,
+                                  ((0.0, 0.0, 0.0, 1.0), (0.3, -0.5, 0.8)), publish_every=10,
+                                  disturbances=disturbances)
+            outbox = []
+            start = time.perf_counter()
+            with body.lock:
+                for _ in range(steps):
+                    body.advance(0, outbox)
+            best = min(best, (time.perf_counter() - start) / steps)
+        lines.append(f'| {name} | {best * 1e6:.1f} |')
     return lines
 
 

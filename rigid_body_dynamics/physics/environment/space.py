@@ -69,6 +69,11 @@ class SpaceEnvironment:
         self._field = 'field' in needs and field is not None
         self.epoch = float(epoch)
         self.env = Surroundings()
+        # (r, B) in the world frame by time: an RK step evaluates a few times more than
+        # once (Butcher's order 6 has 5 distinct nodes in 7 stages, and a step's end is the
+        # next one's start), and they depend on the time alone
+        self._world = {}
+        self._last = (None, None)      # (arguments, torque) of the last call
 
     def moved(self, epoch):
         """Return the same environment whose integrator time 0 is simulated time ``epoch``."""
@@ -78,16 +83,30 @@ class SpaceEnvironment:
         """Fill and return the :class:`Surroundings` at simulated time t (s) and attitude q."""
         env = self.env
         if self._position:
-            env.r_world = r = self.orbit.position(t)
-            env.r_body = _to_body(*q, r)
+            world = self._world.get(t)
+            if world is None:
+                if len(self._world) > 32:
+                    self._world.clear()
+                r = self.orbit.position(t)
+                world = self._world[t] = (r, self.field.world(t, r) if self._field else None)
+            env.r_world, env.b_world = world
+            env.r_body = _to_body(*q, world[0])
             if self._field:
-                env.b_world = b = self.field.world(t, r)
-                env.b_body = _to_body(*q, b)
+                env.b_body = _to_body(*q, world[1])
         return env
 
     def __call__(self, t, qx, qy, qz, qw, wx=0.0, wy=0.0, wz=0.0):
         """Return the summed torque (N m, principal frame) at integrator time t (s)."""
-        t = t + self.epoch
+        args = (t, qx, qy, qz, qw, wx, wy, wz)
+        last, torque = self._last
+        if args == last:          # (the integrator asks at a step's start, then its stage 0)
+            return torque
+        torque = self._torque(t + self.epoch, qx, qy, qz, qw, wx, wy, wz)
+        self._last = (args, torque)
+        return torque
+
+    def _torque(self, t, qx, qy, qz, qw, wx, wy, wz):
+        """Return the summed torque (N m, principal) at simulated time t (s)."""
         q = (qx, qy, qz, qw)
         env = self.surroundings(t, q)
         r, omega = env.r_world, (wx, wy, wz)
