@@ -75,10 +75,6 @@ class SpaceEnvironment:
         self._world = {}
         self._last = (None, None)      # (arguments, torque) of the last call
 
-    def moved(self, epoch):
-        """Return the same environment whose integrator time 0 is simulated time ``epoch``."""
-        return SpaceEnvironment(self.orbit, self.field, self.models, epoch)
-
     def surroundings(self, t, q):
         """Fill and return the :class:`Surroundings` at simulated time t (s) and attitude q."""
         env = self.env
@@ -115,8 +111,3 @@ class SpaceEnvironment:
             a, b, c = model.torque(t, r, q, omega, env)
             tx, ty, tz = tx + a, ty + b, tz + c
         return tx, ty, tz
-
-    @property
-    def active(self):
-        """Whether any torque model acts."""
-        return bool(self.models)
