@@ -157,7 +157,8 @@ def test_libration_and_the_jacobi_integral_over_topics(launch, probe):
     Check the analyzer's orbit status on a librating satellite: frequencies and Jacobi drift.
 
     A 500 km circular orbit, I = (2, 3, 1.2) kg m^2 (Lagrange region) 1-2 mrad off LVLH,
-    turning with it, the gravity gradient alone, 1 s steps as fast as possible;
+    turning with it, the gravity gradient alone, 1 s steps at 5000x (as fast as possible
+    flooded the analyzer's best-effort input under a CPU hog: lost samples cost accuracy);
     attitude_analyzer with gravity_gradient over a 60000 s window (10.6 orbits) of 0.1 Hz
     odom: pitch and both roll-yaw libration frequencies within 1e-4 of the theory's
     (measured 1.6e-5 to 6.9e-5; over 20000 s they were 2e-4 to 8.7e-4), the stability
@@ -176,7 +177,8 @@ def test_libration_and_the_jacobi_integral_over_topics(launch, probe):
            '-p', f'orbit_elements:={elements}', '-p', 'gravity_gradient:=true',
            '-p', f'initial_orientation:={start.as_quat().tolist()}',
            '-p', f'initial_angular_velocity:={omega.tolist()}', '-p', 'integration_rate:=1.0',
-           '-p', 'publish_rate:=0.1', '-p', 'real_time_factor:=0.0', '-p', 'publish_imu:=false',
+           '-p', 'publish_rate:=0.1', '-p', 'real_time_factor:=5000.0',
+           '-p', 'publish_imu:=false',
            name='sim')
     launch('rigid_body_dynamics.nodes.analyzer', '-p', 'gravity_gradient:=true',
            '-p', 'window:=60000.0', '-p', 'max_gap:=100.0', '-p', 'reset_jump:=100.0',
@@ -185,7 +187,7 @@ def test_libration_and_the_jacobi_integral_over_topics(launch, probe):
     theory = libration_modes(moments, orbit.n)
 
     odom = probe.subscribe(Odometry, 'odom')
-    probe.spin_until(lambda: odom and time_ns(odom[-1].header.stamp) >= 60000 * 10 ** 9, 120.0,
+    probe.spin_until(lambda: odom and time_ns(odom[-1].header.stamp) >= 60000 * 10 ** 9, 180.0,
                      '60000 s simulated')
     seen = len(probe.messages['/diagnostics'])
     probe.spin_until(lambda: any(s.name == 'attitude_analyzer: orbit' for a in

@@ -1,10 +1,16 @@
 """Send attitude_simulator a torque of 0.1 N m about its body z axis for 2 s, then stop."""
+import time
+
 from geometry_msgs.msg import WrenchStamped
 import rclpy
 
 rclpy.init()
 node = rclpy.create_node('torque_sender')
 pub = node.create_publisher(WrenchStamped, 'torque_cmd', 10)
+# wait (at most 10 s) until the simulator's subscription has matched: sent before, lost
+deadline = time.monotonic() + 10.0
+while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
+    rclpy.spin_once(node, timeout_sec=0.1)
 
 
 def send():
