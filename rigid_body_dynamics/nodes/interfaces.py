@@ -164,7 +164,8 @@ SIMULATOR = Interfaces('attitude_simulator', [
 
 ANALYZER = Interfaces('attitude_analyzer', [
     Interface('sub', 'odom', 'nav_msgs/msg/Odometry',
-              'Attitude and angular velocity; best effort, depth 1000, taken every 100 ms '
+              'Attitude and angular velocity (with `gravity_gradient`, the position and '
+              'linear velocity too); best effort, depth 1000, taken every 100 ms '
               '(hidden helper node `_attitude_analyzer_intake`).'),
     Interface('sub', 'applied_torque', 'geometry_msgs/msg/WrenchStamped',
               'Body torque (N m); with torque in the window the balance laws are checked '
@@ -181,7 +182,8 @@ ANALYZER = Interfaces('attitude_analyzer', [
     Interface('pub', 'kinetic_energy', 'std_msgs/msg/Float64', 'T (J).'),
     Interface('pub', 'angular_momentum_norm', 'std_msgs/msg/Float64', '|L| (kg m^2/s).'),
     Interface('pub', '/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray',
-              'Every `diagnostic_period`: `conservation`, `precession`, `stability`, `input`.'),
+              'Every `diagnostic_period`: `conservation`, `precession`, `stability`, `input` '
+              '(and `orbit` with `gravity_gradient`: libration and the Jacobi integral).'),
     Interface('srv', '~/reset_baseline', 'std_srvs/srv/Trigger',
               'Measure drift from the next sample on.'),
 ])
