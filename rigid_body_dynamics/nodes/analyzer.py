@@ -134,6 +134,15 @@ PARAMETERS = ParameterTable([
 ], cross_checks=(_wheels,))
 
 
+def _insert(stamps, values, t, value):
+    """Insert ``value`` stamped ``t`` (ns) into the sorted ``stamps`` and ``values``, once."""
+    i = bisect.bisect_left(stamps, t)
+    if i < len(stamps) and stamps[i] == t:
+        return
+    stamps.insert(i, t)
+    values.insert(i, value)
+
+
 class SampleBuffer:
     """
     Attitude samples sorted by stamp (integer ns): q (x, y, z, w), omega (rad/s, body).
@@ -171,27 +180,15 @@ class SampleBuffer:
 
     def add_torque(self, t, torque):
         """Insert one applied-torque sample (stamp t, ns) in stamp order."""
-        i = bisect.bisect_left(self.torque_t, t)
-        if i < len(self.torque_t) and self.torque_t[i] == t:
-            return
-        self.torque_t.insert(i, t)
-        self.torque.insert(i, torque)
+        _insert(self.torque_t, self.torque, t, torque)
 
     def add_wheels(self, t, speeds, efforts):
         """Insert one wheel_state sample (stamp t, ns): speeds (rad/s), motor torques (N m)."""
-        i = bisect.bisect_left(self.wheel_t, t)
-        if i < len(self.wheel_t) and self.wheel_t[i] == t:
-            return
-        self.wheel_t.insert(i, t)
-        self.wheel.insert(i, (tuple(speeds), tuple(efforts)))
+        _insert(self.wheel_t, self.wheel, t, (tuple(speeds), tuple(efforts)))
 
     def add_orbit(self, t, position, velocity):
         """Insert one orbit sample (stamp t, ns): position (m) and velocity (m/s), world."""
-        i = bisect.bisect_left(self.orbit_t, t)
-        if i < len(self.orbit_t) and self.orbit_t[i] == t:
-            return
-        self.orbit_t.insert(i, t)
-        self.orbit.insert(i, (tuple(position), tuple(velocity)))
+        _insert(self.orbit_t, self.orbit, t, (tuple(position), tuple(velocity)))
 
     def orbit_arrays(self):
         """Return (position, velocity) (N, 3) at the state stamps, or None unless all have one."""
