@@ -4,7 +4,7 @@ The simulators users would otherwise pick, on the same free body and steps.
 Optional: needs ``mujoco`` and ``bsk`` (Basilisk) from the registry,
 ``.venv/bin/pip install -r benchmarks/requirements-peers.txt``. Not run in CI.
 
-Case (from issue 2): tennis racket I = (1, 2, 3) kg m^2, omega0 = (0.01, 2, 0.01)
+Case: tennis racket I = (1, 2, 3) kg m^2, omega0 = (0.01, 2, 0.01)
 rad/s body, 10 ms steps, 200 s. Reported: largest relative energy error,
 final attitude error against our exact solution, wall time per simulated
 second and its ratio to our rk4 measured in the same run.

@@ -1,7 +1,7 @@
 """
 simulate() with a callable torque across the separatrix: cost and accuracy, frames and torques.
 
-The held-out case of issue 24: I = (1, 2, 3) kg m^2, omega0 = (0.02, 2.0, 0.05) rad/s
+The held-out case: I = (1, 2, 3) kg m^2, omega0 = (0.02, 2.0, 0.05) rad/s
 (a spin next to the intermediate axis), a torque of 0.2 N m about axis 1 that carries
 it across the separatrix (S/G^2 from +4.4e-4 to -3.2e-2), 20 s at dt = 10 ms, the torque
 a callable evaluated at every step. Variants: the body given by its principal moments

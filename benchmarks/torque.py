@@ -1,7 +1,7 @@
 """
 Under a held torque (a controller's zero-order hold): accuracy against cost.
 
-Two cases from issue 10, torque updated every HOLD = 10 ms and held in
+Two cases, torque updated every HOLD = 10 ms and held in
 between, 20 s:
 
 - T1 open loop: tau(t_k) = (0.3 sin 0.7 t_k, 0.2 cos 1.3 t_k, 0.25 sin(0.4 t_k + 1)) N m
@@ -17,7 +17,7 @@ relative to the run's largest |omega_ref| (T2 settles to rest, where a
 pointwise relative error means nothing). Cost is wall time per simulated
 second, also as a ratio to a plain pure-Python RK4 (``plain_rk4``, the
 textbook code a user would write) at 1 ms measured in the same run, the unit
-of issue 10; each cost is the least of five runs (two for the peers). The
+of cost; each cost is the least of five runs (two for the peers). The
 balance column is max |T - T0 - W| / T0 of our steppers (W is the stepper's
 quadrature of omega . tau, not a by-construction quantity).
 

@@ -1,7 +1,7 @@
 """
 Reaction wheels side by side with Basilisk: accuracy against DOP853 and cost.
 
-Two cases (issue 25), each against scipy's DOP853 of the gyrostat at rtol 2.5e-14,
+Two cases, each against scipy's DOP853 of the gyrostat at rtol 2.5e-14,
 restarted at every 10 ms hold (``physics.reference.gyrostat_zoh_reference``):
 
 - W1 torque-free gyrostat: I = (1, 2, 3) kg m^2 (wheels locked in), three wheels on the
