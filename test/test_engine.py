@@ -262,10 +262,10 @@ def test_commands_act_from_the_step_they_came_in_as_if_stepped_every_deadline():
     times[40:] += int(0.2e9)                                          # a gap: the watchdog acts
     vectors = rng.normal(scale=0.2, size=(60, 3))
     vectors[[7, 33]] = np.nan
-    from rigid_body_dynamics.physics.sensors import GyroErrors
-    options = {'publish_every': 10, 'torque_timeout': 0.05, 'imu_every': 4, 'seed': 9,
-               'gyro': GyroErrors(1e-3, 1e-4, 1e-3)}
-    paced, ref = make_body(**options), make_body(**options)
+    from rigid_body_dynamics.physics.sensors import Gyro, GyroErrors
+    options = {'publish_every': 10, 'torque_timeout': 0.05, 'seed': 9}
+    paced, ref = (make_body(sensors=[Gyro(GyroErrors(1e-3, 1e-4, 1e-3), 250.0)], **options)
+                  for _ in range(2))
     pending = list(zip(times.tolist(), vectors))
 
     def inbox():

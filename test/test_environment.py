@@ -20,6 +20,7 @@ from rigid_body_dynamics.physics.environment import (
     circular_elements, DipoleField, GravityGradient, KeplerOrbit, lvlh_axes, lvlh_quaternion,
     MagneticDipole, MU_EARTH, SpaceEnvironment)
 from rigid_body_dynamics.physics.reference import space_zoh_reference
+from rigid_body_dynamics.physics.sensors import Magnetometer
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
@@ -292,8 +293,7 @@ def test_bdot_detumbles_a_3u_cubesat_in_a_polar_orbit_within_an_orbit():
                           torque_timeout=0.0, publish_every=10,
                           disturbances=Disturbances(orbit=orbit, field=DipoleField(),
                                                     gravity_gradient=True),
-                          magnetorquers=(0.2, 0.2, 0.2), magnetometer=(0.0, (0.0, 0.0, 0.0)),
-                          magnetometer_every=10)
+                          magnetorquers=(0.2, 0.2, 0.2), sensors=[Magnetometer(1.0)])
     run = detumble(body, BDot(1e5, (0.2, 0.2, 0.2)), orbit.period)
     assert run['reached'] is not None and run['reached'] < orbit.period
     assert run['reached'] == pytest.approx(3719.0, abs=10.0)

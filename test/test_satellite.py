@@ -18,6 +18,7 @@ from rigid_body_dynamics.engine.offline import detumble
 from rigid_body_dynamics.physics import Inertia
 from rigid_body_dynamics.physics.control import BDot
 from rigid_body_dynamics.physics.environment import DipoleField, KeplerOrbit
+from rigid_body_dynamics.physics.sensors import Magnetometer
 from rigid_body_dynamics.ros.conversions import time_ns
 from ros_harness import odom_arrays
 import yaml
@@ -40,7 +41,7 @@ def _offline(seconds):
         disturbances=Disturbances(orbit=KeplerOrbit(common['orbit_elements']),
                                   field=DipoleField(), gravity_gradient=True),
         magnetorquers=tuple(common['magnetorquer_max_dipole']),
-        magnetometer=(0.0, (0.0, 0.0, 0.0)), magnetometer_every=every)
+        sensors=[Magnetometer(sim['magnetometer_rate'])])
     gain = config['/**/attitude_controller']['ros__parameters']['bdot_gain']
     return detumble(body, BDot(gain, tuple(common['magnetorquer_max_dipole'])), seconds)
 

@@ -12,12 +12,12 @@ every mode. The nodes in ``nodes/`` (with the
 plumbing in ``ros/``) are the ROS side around them.
 """
 
-from .body import BodySimulation, Disturbances, ImuSample, MagneticSample, Snapshot, TorqueCommand
+from .body import BodySimulation, Disturbances, SensorSample, Snapshot, TorqueCommand
 from .commands import DipoleCommands, Mailbox, TorqueCommands, WheelCommands
 from .lockstep import Lockstep
 from .loop import Loop, Member
 from .pacer import Pace
 
-__all__ = ['BodySimulation', 'DipoleCommands', 'Disturbances', 'ImuSample', 'Lockstep', 'Loop',
-           'MagneticSample', 'Mailbox', 'Member', 'Pace', 'Snapshot', 'TorqueCommand',
-           'TorqueCommands', 'WheelCommands']
+__all__ = ['BodySimulation', 'DipoleCommands', 'Disturbances', 'Lockstep', 'Loop', 'Mailbox',
+           'Member', 'Pace', 'SensorSample', 'Snapshot', 'TorqueCommand', 'TorqueCommands',
+           'WheelCommands']

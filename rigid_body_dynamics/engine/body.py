@@ -17,9 +17,11 @@ each step, the environment's torque models (gravity gradient, residual
 dipole, magnetorquers: :mod:`rigid_body_dynamics.physics.environment`)
 evaluated at every RK stage.
 
-Ticks. Every item a body puts out (the state, the gyro's and the
-magnetometer's samples) comes every whole number of steps; :meth:`BodySimulation.ticks`
-is that one schedule, which the paces read (:meth:`BodySimulation.steps_to_tick`).
+Ticks. Every item a body puts out (the state, each sensor's readings) comes every
+whole number of steps; one schedule says when (:meth:`BodySimulation.steps_to_tick`,
+which the paces read). Sensors are objects on the protocol of
+:mod:`rigid_body_dynamics.physics.sensors.base` (``sample(state, t, rng)``), each
+with a seeded stream of its own; their readings leave as :class:`SensorSample`.
 """
 
 from dataclasses import dataclass
@@ -31,10 +33,10 @@ import numpy as np
 
 from .commands import TorqueCommands
 from ..physics import make_integrator, quaternions
-from ..physics.environment import (GravityGradient, MagneticDipole, Magnetorquers,
+from ..physics.environment import (GravityGradient, MagneticDipole, Magnetorquers, R_EARTH,
                                    SpaceEnvironment)
 from ..physics.gyrostat import GyrostatIntegrator
-from ..physics.sensors import GyroErrors, GyroModel, Magnetometer
+from ..physics.sensors import BodyTruth, Sky, stream_rng
 
 _ZERO = (0.0, 0.0, 0.0)
 _NS = 1_000_000_000
@@ -69,7 +71,10 @@ class Disturbances:
     (None = no orbit); ``field``: a
     :class:`~rigid_body_dynamics.physics.environment.DipoleField` (None = none);
     ``gravity_gradient``: its torque on the orbit; ``residual_dipole`` (A m^2,
-    body frame): the torque m x B in the field.
+    body frame): the torque m x B in the field. ``sun`` (a
+    :class:`~rigid_body_dynamics.physics.environment.Sun`, None = none) and
+    ``planet_radius`` (m) are what the sensors see (the Sun, the shadow, the
+    Earth's disc); they make no torque.
     """
 
     body: tuple = _ZERO
@@ -78,6 +83,8 @@ class Disturbances:
     field: object = None
     gravity_gradient: bool = False
     residual_dipole: tuple = _ZERO
+    sun: object = None
+    planet_radius: float = R_EARTH
 
     @property
     def active(self):
@@ -94,34 +101,18 @@ class Disturbances:
         return ', '.join(parts) or 'none'
 
 
-class ImuSample(NamedTuple):
+class SensorSample(NamedTuple):
     """
-    One gyro sample, in the user's body frame (the field names say so).
+    One sensor reading as the body puts it out: ``stamp_ns`` (int ns), ``sensor`` (its name).
 
-    ``stamp_ns``, the reported attitude ``q_body`` (x, y, z, w, body -> world, with
-    orientation noise), the measured rate ``omega_body`` (rad/s) and the true
-    ``bias_body`` (rad/s), and the gyro's ``rate_variance`` (rad/s)^2 and
-    ``orientation_variance`` (rad^2) per axis.
-    """
-
-    stamp_ns: int
-    q_body: tuple
-    omega_body: tuple
-    bias_body: tuple
-    rate_variance: float
-    orientation_variance: float
-
-
-class MagneticSample(NamedTuple):
-    """
-    One magnetometer reading: ``stamp_ns``, ``field_body`` (T, the user's body frame).
-
-    ``variance`` (T^2 per axis) is the white noise's, for the message covariance.
+    ``reading`` is the sensor's NamedTuple (e.g. a
+    :class:`~rigid_body_dynamics.physics.sensors.GyroReading`), in the user's body
+    frame or the world frame as that sensor says.
     """
 
     stamp_ns: int
-    field_body: tuple
-    variance: float
+    sensor: str
+    reading: tuple
 
 
 class WheelState(NamedTuple):
@@ -276,9 +267,10 @@ class BodySimulation:
     ``inertia`` (Inertia), ``integrator`` (a name from INTEGRATORS), ``rate``
     (Hz; dt = 1 / rate), ``initial`` = (q0 x-y-z-w, omega0 rad/s) in the body
     frame, ``torque_timeout`` (s; 0 = hold forever), ``max_torque`` (N m per
-    axis; 0 = no limit), ``publish_every`` (steps per publish tick), ``imu_every``
-    (steps per gyro sample, 0 = none), ``gyro`` (GyroErrors; None = perfect) and
-    its ``seed``, ``start_ns`` (stamp of simulated time 0), ``disturbances``
+    axis; 0 = no limit), ``publish_every`` (steps per publish tick), ``sensors``
+    (objects on the sensor protocol, each sampled every round(rate / its rate)
+    steps, at least 1) and the ``seed`` of their streams, ``start_ns`` (stamp of
+    simulated time 0), ``disturbances``
     (:class:`Disturbances`; None = none), ``wheels`` (a
     :class:`~rigid_body_dynamics.physics.gyrostat.Wheels` in the body frame, or None)
     and their ``wheel_speeds`` at the start (rad/s; default 0): with wheels the body is
@@ -287,8 +279,8 @@ class BodySimulation:
     no limit; None = no magnetorquers) makes the dipole a command too
     (``DipoleCommands``, body frame, clipped per axis, held and timed out like
     the torque; its torque m x B acts through the environment's field).
-    ``magnetometer`` = (noise T, bias T body) samples the field every
-    ``magnetometer_every`` steps (0 = none). ``notes`` collects what a node should
+    ``sensor_counts`` counts each sensor's readings ('valid') and exclusions
+    (by the reason the sensor gives) since the start. ``notes`` collects what a node should
     log (the watchdog's timeouts, lockstep's misses), drained with
     :meth:`take_notes`; ``events`` the command events since the last
     :meth:`take_events` (for the node's warnings).
@@ -300,17 +292,17 @@ class BodySimulation:
     ``lock`` (re-entrant) guards the state. The methods other threads call take it
     themselves: :meth:`reset`, :meth:`set_paused`, :meth:`configure`,
     :meth:`check`, :meth:`hold`, :meth:`command`, :meth:`reject`, :meth:`note`,
-    :meth:`take_notes`, :meth:`take_events`, :meth:`health`. The stepping methods
+    :meth:`take_notes`, :meth:`take_events`, :meth:`health`, :meth:`sensor_health`. The
+    stepping methods
     are called by the one thread that holds it for a whole wake (the engine's
     Pace or Lockstep) and say "call under ``lock``": :meth:`advance`,
     :meth:`advance_free`, :meth:`torque_now`, :meth:`first_items`,
-    :meth:`imu_sample`, :meth:`snapshot`, :meth:`invariants`, :meth:`body_state`.
+    :meth:`snapshot`, :meth:`invariants`, :meth:`body_state`.
     """
 
     def __init__(self, inertia, integrator, rate, initial, torque_timeout=0.5, max_torque=0.0,
-                 publish_every=1, start_ns=0, imu_every=0, gyro=None, seed=0,
-                 disturbances=None, wheels=None, wheel_speeds=None, magnetorquers=None,
-                 magnetometer=None, magnetometer_every=0):
+                 publish_every=1, start_ns=0, sensors=(), seed=0,
+                 disturbances=None, wheels=None, wheel_speeds=None, magnetorquers=None):
         self.lock = threading.RLock()
         self.rate = float(rate)
         self.dt = 1.0 / self.rate
@@ -322,10 +314,13 @@ class BodySimulation:
         self.timeout_ns = int(torque_timeout * _NS)
         self.max_torque = float(max_torque)
         self.publish_every = int(publish_every)
-        self.imu_every = int(imu_every)       # steps per gyro sample; 0 = no IMU
-        self.gyro_errors = gyro if gyro is not None else GyroErrors()
         self.seed = int(seed)
         self.disturbances = disturbances or Disturbances()
+        d = self.disturbances
+        self.sky = Sky(d.field, d.sun, d.planet_radius)
+        # (steps per reading, sensor): a sensor between two steps samples at the nearer one
+        self.sensors = [(max(1, round(self.rate / sensor.rate)), sensor) for sensor in sensors]
+        self.sensor_counts = {sensor.name: {'valid': 0} for _, sensor in self.sensors}
         self.wheels = wheels if wheels is not None and wheels.count else None
         n = self.wheels.count if self.wheels is not None else 0
         self.wheel_speeds0 = tuple(float(v) for v in wheel_speeds) if wheel_speeds else (0.0,) * n
@@ -336,8 +331,6 @@ class BodySimulation:
         self.counts = dict.fromkeys(COUNTS, 0)
         self.max_dipole = None if magnetorquers is None else tuple(float(c) for c in magnetorquers)
         self.dipole_counts = dict.fromkeys(DIPOLE_COUNTS, 0)
-        self.magnetometer_config = magnetometer
-        self.magnetometer_every = int(magnetometer_every) if magnetometer is not None else 0
         self.notes = []
         self.events = set()
         self._schedule = self._make_schedule()
@@ -363,10 +356,12 @@ class BodySimulation:
             self._motors_given = None        # the motor torques the stepper holds
             self._dipole_given = _ZERO       # the dipole (body) the environment holds
             self._held = (_ZERO, None, None)
-            self.gyro = GyroModel(self.gyro_errors, self.rate / max(self.imu_every, 1),
-                                  self.seed)     # same seed: the same stream after a reset
-            self.magnetometer = None if self.magnetometer_config is None else Magnetometer(
-                *self.magnetometer_config, seed=self.seed)
+            # the same seeds: the same streams after a reset
+            self._streams = []
+            for every, sensor in self.sensors:
+                rng = stream_rng(self.seed, sensor.stream)
+                sensor.start(rng, self.rate / every)
+                self._streams.append(rng)
             self._disturb()
             self._baseline()
 
@@ -464,7 +459,8 @@ class BodySimulation:
                 self.publish_every = int(publish_every)
                 self._schedule = self._make_schedule()
             if disturbances is not None and disturbances != self.disturbances:
-                self.disturbances = disturbances
+                self.disturbances = d = disturbances
+                self.sky = Sky(d.field, d.sun, d.planet_radius)
                 self._disturb()
                 self._base_stale = True
                 lines.append(f'disturbances now {disturbances}')
@@ -729,13 +725,15 @@ class BodySimulation:
         self._ticks(outbox)
 
     def _make_schedule(self):
-        """Return the ticks: (steps per item, the method that takes the item), state first."""
+        """Return the ticks: (steps per item, the method that takes it or None), state first."""
         schedule = [(self.publish_every, self.snapshot)]
-        if self.imu_every:
-            schedule.append((self.imu_every, self.imu_sample))
-        if self.magnetometer_every:
-            schedule.append((self.magnetometer_every, self.magnetometer_sample))
+        for index, (every, _) in enumerate(self.sensors):
+            schedule.append((every, lambda index=index: self.read_sensor(index)))
         return schedule
+
+    def every(self, name):
+        """Return the steps between two readings of the sensor called ``name`` (0 = none)."""
+        return next((every for every, sensor in self.sensors if sensor.name == name), 0)
 
     @property
     def shortest_tick(self):
@@ -752,7 +750,9 @@ class BodySimulation:
         steps = self.steps
         for every, take in self._schedule:
             if steps % every == 0:
-                outbox.append(take())
+                item = take()
+                if item is not None:
+                    outbox.append(item)
 
     def advance_free(self, count, now_ns, outbox):
         """
@@ -787,24 +787,36 @@ class BodySimulation:
 
     def first_items(self):
         """Return the items of time 0 (call under ``lock``): the state and sensor samples."""
-        return [take() for _, take in self._schedule]
+        items = (take() for _, take in self._schedule)
+        return [item for item in items if item is not None]
 
-    def imu_sample(self):
-        """Sample the gyro at the current state (call under ``lock``): an :class:`ImuSample`."""
-        gyro = self.gyro
-        q, measured, bias = gyro.read(*self.body_state())
-        return ImuSample(self.stamp_now(), q, measured, bias,
-                         gyro.rate_variance, gyro.orientation_variance)
+    def truth(self):
+        """Return the :class:`~rigid_body_dynamics.physics.sensors.BodyTruth` now (under lock)."""
+        q, omega = self.body_state()
+        orbit = self.disturbances.orbit
+        r = None if orbit is None else orbit.position(self.steps * self.dt)
+        return BodyTruth(tuple(q), tuple(omega), r, self.sky)
 
-    def magnetometer_sample(self):
-        """Read the magnetometer at the current state (call under ``lock``): a MagneticSample."""
-        d = self.disturbances
-        t = self.steps * self.dt
-        b_world = d.field.world(t, d.orbit.position(t))
-        q = self.body_state()[0]
-        b_body = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), b_world)
-        m = self.magnetometer
-        return MagneticSample(self.stamp_now(), m.read(b_body), m.variance)
+    def read_sensor(self, index):
+        """
+        Read sensor ``index`` at the current state (call under ``lock``).
+
+        Returns a :class:`SensorSample`, or None when the sensor gives a reason
+        instead of a reading (counted under that reason).
+        """
+        sensor = self.sensors[index][1]
+        reading = sensor.sample(self.truth(), self.steps * self.dt, self._streams[index])
+        counts = self.sensor_counts[sensor.name]
+        if isinstance(reading, str):
+            counts[reading] = counts.get(reading, 0) + 1
+            return None
+        counts['valid'] += 1
+        return SensorSample(self.stamp_now(), sensor.name, reading)
+
+    def sensor_health(self):
+        """Return each sensor's counts of readings and exclusions since the start (a copy)."""
+        with self.lock:
+            return {name: dict(counts) for name, counts in self.sensor_counts.items()}
 
     def stamp_now(self):
         """Return the stamp (int ns) of the current simulated time."""

@@ -10,7 +10,6 @@ attitude_controller's ``bdot`` mode answers ``magnetic_field`` with
 
 import math
 
-from .body import MagneticSample
 from .commands import DipoleCommands
 
 
@@ -19,12 +18,12 @@ def detumble(body, law, duration, target_rate=math.radians(0.5)):
     Fly ``law`` (BDot) on ``body`` for ``duration`` s; return what happened.
 
     ``body``: a BodySimulation with magnetorquers and a magnetometer (its
-    ``magnetometer_every`` steps are the control period). Returns a dict: the
+    readings are the control period). Returns a dict: the
     sample ``times`` (s), ``rates`` |omega| (rad/s) and ``dipoles`` (A m^2, body)
     at each, and ``reached`` the first time (s) |omega| <= ``target_rate`` (rad/s),
     or None.
     """
-    every = body.magnetometer_every
+    every = body.every('magnetometer')
     if not every or body.max_dipole is None:
         raise ValueError('detumble needs a body with magnetorquers and a magnetometer')
     times, rates, dipoles, reached = [], [], [], None
@@ -32,9 +31,9 @@ def detumble(body, law, duration, target_rate=math.radians(0.5)):
         items = body.first_items()
         for _ in range(int(round(duration / (every * body.dt)))):
             for item in items:
-                if isinstance(item, MagneticSample):
+                if getattr(item, 'sensor', None) == 'magnetometer':
                     t = item.stamp_ns * 1e-9
-                    m = law.dipole(t, item.field_body)
+                    m = law.dipole(t, item.reading.field)
                     body.hold(body.check(DipoleCommands.one(m, 0, item.stamp_ns)), 0, 1)
                     w = body.stepper.omega
                     rate = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])

@@ -9,6 +9,7 @@ values into the engine's
 that names the parameter.
 """
 
+from .sensor_parameters import sun_from
 from ..engine import Disturbances
 from ..physics.environment import (DipoleField, EARTH_RATE, IGRF13_2020, KeplerOrbit,
                                    MU_EARTH, R_EARTH)
@@ -87,9 +88,10 @@ def environment_from(out):
     """
     Return the engine's Disturbances of a simulator's validated values ``out``.
 
-    Reads disturbance_torque_body / _world and every environment parameter;
-    refuses (ConfigurationError, naming the parameter) a gravity gradient, field
-    or magnetometer without what it needs.
+    Reads disturbance_torque_body / _world, every environment parameter and the
+    Sun's (epoch, sun_direction: :func:`.sensor_parameters.sun_from`); refuses
+    (ConfigurationError, naming the parameter) a gravity gradient, field or
+    magnetometer without what it needs.
     """
     orbit = orbit_from(out)
     field = None
@@ -113,9 +115,7 @@ def environment_from(out):
     if any(c < 0.0 for c in out['magnetorquer_max_dipole']):
         raise ConfigurationError('magnetorquer_max_dipole must be >= 0 per axis (0 = no limit), '
                                  f'got {list(out["magnetorquer_max_dipole"])}')
-    if out['magnetometer_rate'] > out['integration_rate']:
-        raise ConfigurationError(f'magnetometer_rate must be at most integration_rate '
-                                 f'({out["integration_rate"]:g} Hz), got '
-                                 f'{out["magnetometer_rate"]:g}')
+    sun = sun_from(out, orbit) if 'epoch' in out else None
     return Disturbances(out['disturbance_torque_body'], out['disturbance_torque_world'], orbit,
-                        field, out['gravity_gradient'], out['residual_dipole'])
+                        field, out['gravity_gradient'], out['residual_dipole'], sun,
+                        out['planet_radius'])

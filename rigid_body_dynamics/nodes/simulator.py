@@ -48,7 +48,6 @@ from .simulator_diagnostics import SimulatorReport
 from .simulator_parameters import PARAMETERS, state_topics
 from ..engine import BodySimulation, Lockstep, Loop, Member, Pace
 from ..physics import presets
-from ..physics.sensors import GyroErrors
 from ..ros.command_decoder import decode_dipoles, decode_wheels, steady_times, TorqueDecoder
 from ..ros.intake import Intake
 from ..ros.runner import run
@@ -132,18 +131,11 @@ class AttitudeSimulator(Node):
             (values['initial_orientation'], values['initial_angular_velocity']),
             0.0 if self.lockstep else values['torque_timeout'], values['max_torque'],
             self._publish_every(values['publish_rate']), start_ns,
-            imu_every=self._publish_every(values['imu_rate']) if values['publish_imu'] else 0,
-            gyro=GyroErrors(values['gyro_noise_density'], values['gyro_bias_random_walk'],
-                            values['gyro_turn_on_bias'], values['gyro_bias_correlation_time'],
-                            values['orientation_noise'], values['gyro_resolution']),
-            seed=values['noise_seed'], disturbances=values['disturbances'],
+            sensors=values['sensors'], seed=values['noise_seed'],
+            disturbances=values['disturbances'],
             wheels=values['wheels'], wheel_speeds=values['wheel_speeds'],
             magnetorquers=values['magnetorquer_max_dipole']
-            if values['disturbances'].field is not None else None,
-            magnetometer=(values['magnetometer_noise'], values['magnetometer_bias'])
-            if values['magnetometer_rate'] > 0.0 else None,
-            magnetometer_every=self._publish_every(values['magnetometer_rate'])
-            if values['magnetometer_rate'] > 0.0 else 0)
+            if values['disturbances'].field is not None else None)
         self._lvlh_frame = values['lvlh_frame']
         self._publish_rate = values['publish_rate']
         self._decoder = TorqueDecoder(self._frames)
@@ -228,13 +220,12 @@ class AttitudeSimulator(Node):
     def _make_interfaces(self):
         publish_tf = self.get_parameter('publish_tf').value
         self.state = StatePublisher(
-            self, self._frames, publish_imu=self.get_parameter('publish_imu').value,
-            publish_clock=self._publish_clock, publish_tf=publish_tf,
+            self, self._frames, publish_clock=self._publish_clock, publish_tf=publish_tf,
             topics=state_topics(self.get_parameter('state_topics').value),
             wheels=self.body.wheels.count if self.body.wheels is not None else 0,
             orbit=self.body.disturbances.orbit is not None, lvlh_frame=self._lvlh_frame,
             magnetorquers=self.body.max_dipole is not None,
-            magnetometer=bool(self.body.magnetometer_every))
+            sensors=[sensor.name for _, sensor in self.body.sensors])
         if publish_tf and not tf_available():
             self.get_logger().info('publish_tf: tf2_msgs is not importable here (no tf2_msgs '
                                    'wheel exists; on a ROS install it is), so /tf is not '

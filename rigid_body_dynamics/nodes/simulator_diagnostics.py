@@ -8,7 +8,10 @@ per tick. ``torque command``: age, timeout, frame, vector and the counters.
 ``magnetorquers`` (with a magnetic field): the dipole applied, the command held, the
 counts of accepted, refused (non-finite, frame), clipped and stale commands;
 ``reaction wheels`` (with wheels): speeds, speed over limit, motor torques applied,
-the held command, clipped and cut-off steps, motor work, friction loss, counters.
+the held command, clipped and cut-off steps, motor work, friction loss, counters;
+``sensors`` (with any sensor): each sensor's readings and the readings it did not
+give, by reason (the star tracker's Sun and Earth exclusions, the sun sensor's field
+of view and eclipses).
 """
 
 import math
@@ -37,7 +40,21 @@ class SimulatorReport:
             out.append(self._wheels(name, hardware_id))
         if self._health['magnetorquers'] is not None:
             out.append(self._magnetorquers(name, hardware_id))
+        if self.body.sensors:
+            out.append(self._sensors(name, hardware_id))
         return out
+
+    def _sensors(self, name, hw):
+        counts = self.body.sensor_health()
+        values, parts = [], []
+        for sensor, numbers in counts.items():
+            values.append((f'{sensor} readings', numbers['valid']))
+            missing = {why: n for why, n in numbers.items() if why != 'valid'}
+            values += [(f'{sensor} excluded ({why})', n) for why, n in sorted(missing.items())]
+            parts.append(f'{sensor} {numbers["valid"]}' + (
+                f' ({sum(missing.values())} excluded)' if missing else ''))
+        return status(f'{name}: sensors', DiagnosticStatus.OK,
+                      'readings: ' + ', '.join(parts), values, hw)
 
     def _wheels(self, name, hw):
         w = self._health['wheels']

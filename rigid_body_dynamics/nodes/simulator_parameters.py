@@ -9,6 +9,7 @@ cross-checks below give every refusal its reason.
 import math
 
 from .environment_parameters import environment_from, environment_params
+from .sensor_parameters import sensor_params, sensors_from
 from .wheel_parameters import WHEEL_PARAMS, wheel_params, wheels_from
 from ..physics import Inertia, INTEGRATORS, presets
 from ..physics.gyrostat import GyrostatIntegrator
@@ -64,11 +65,9 @@ def _body(values, out):
         raise ConfigurationError(str(err)) from None
 
 
-def _imu_rate(values, out):
-    """Cross-check: imu_rate <= integration_rate."""
-    if out['imu_rate'] > out['integration_rate']:
-        raise ConfigurationError(f'imu_rate must be at most integration_rate '
-                                 f'({out["integration_rate"]:g} Hz), got {out["imu_rate"]:g}')
+def _sensors(values, out):
+    """Cross-check: the sensors (gyro, magnetometer, star tracker, sun sensor), out['sensors']."""
+    out['sensors'] = sensors_from(out, out['disturbances'])
 
 
 def _control_steps(values, out):
@@ -244,11 +243,13 @@ PARAMETERS = ParameterTable([
     Param('disturbance_torque_world', 'double[3]', [0.0, 0.0, 0.0], '[0, 0, 0] N m',
           'Constant disturbance torque fixed in the world frame, added to the command.'),
     *environment_params(),
+    *sensor_params(),
     Param('noise_seed', 'int', 0, '0',
-          'Seed of the gyro noise: the same seed and parameters give the same imu stream, bit '
-          'for bit (also after ~/reset).', low=0, high=2 ** 31 - 1, read_only=True),
+          "Seed of the sensors' noise: the same seed and parameters give the same streams, bit "
+          'for bit (also after ~/reset); each sensor draws from a stream of its own, so turning '
+          'one on leaves the others unchanged.', low=0, high=2 ** 31 - 1, read_only=True),
     *wheel_params(*WHEEL_PARAMS),
-], cross_checks=(_body, _publish_rate, _imu_rate, _control_steps, _disturbances, _wheels,
+], cross_checks=(_body, _publish_rate, _control_steps, _disturbances, _sensors, _wheels,
                  _lockstep_answer))
 
 

@@ -12,6 +12,8 @@ broadcasts. Hot loops use the component kernels ``mul_components`` and
 equally shaped arrays) and so avoid numpy's per-call overhead on 3-vectors.
 """
 
+import math
+
 import numpy as np
 
 
@@ -105,3 +107,43 @@ def angle_between(q1, q2):
     d = multiply(conjugate(q1), q2)
     vec = np.sqrt(np.sum(d[..., :3] ** 2, axis=-1))
     return 2.0 * np.arctan2(vec, np.abs(d[..., 3]))
+
+
+def from_rotation_vector(v):
+    """
+    Quaternion (x, y, z, w) of the rotation vector ``v`` (rad; axis times angle), as a tuple.
+
+    exp(v / 2) for one vector (3,), in scalar arithmetic (a sensor draws one per
+    reading); accurate to round-off at small angles (the sinc is a series there).
+    """
+    x, y, z = (float(c) for c in v)
+    angle2 = x * x + y * y + z * z
+    if angle2 < 1e-12:          # sin(a/2)/a = 1/2 - a^2/48 + ..., cos(a/2) = 1 - a^2/8 + ...
+        s, c = 0.5 - angle2 / 48.0, 1.0 - angle2 / 8.0 + angle2 * angle2 / 384.0
+    else:
+        angle = angle2 ** 0.5
+        s, c = math.sin(0.5 * angle) / angle, math.cos(0.5 * angle)
+    return (s * x, s * y, s * z, c)
+
+
+def to_rotation_vector(q):
+    """
+    Rotation vector (rad; axis times angle, angle in [0, pi]) of quaternions q (..., 4).
+
+    The inverse of :func:`from_rotation_vector`, insensitive to the sign q ~ -q.
+    """
+    q = np.asarray(q, dtype=float)
+    q = np.where(q[..., 3:4] < 0.0, -q, q)
+    vec = np.sqrt(np.sum(q[..., :3] ** 2, axis=-1, keepdims=True))
+    angle = 2.0 * np.arctan2(vec, q[..., 3:4])
+    scale = np.where(vec > 1e-300, angle / np.where(vec > 1e-300, vec, 1.0), 2.0)
+    return q[..., :3] * scale
+
+
+def matrix(q):
+    """Return the 3 x 3 rotation R of a unit quaternion (x, y, z, w): v_world = R v_body."""
+    x, y, z, w = (float(c) for c in q)
+    return np.array([
+        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
+        [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
+        [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)]])

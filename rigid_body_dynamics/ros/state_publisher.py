@@ -4,14 +4,15 @@ StatePublisher: the state topics of one simulated body, as a helper that takes a
 Like tf2_ros' ``TransformBroadcaster(node)``: the node keeps its parameters,
 subscriptions and services; this object owns the publishers of ``odom``,
 ``orientation``, ``angular_velocity``, ``angular_momentum``,
-``angular_momentum_body``, ``applied_torque``, ``imu`` and ``~/imu_bias``
-(optional; from the engine's gyro samples), ``magnetic_field`` (the
-magnetometer's samples), ``applied_dipole`` (with magnetorquers), the latched
+``angular_momentum_body``, ``applied_torque``, the sensors' topics (``imu`` and
+``~/imu_bias`` from the gyro, ``magnetic_field`` from the magnetometer,
+``star_tracker``, ``sun_sensor``), ``applied_dipole`` (with magnetorquers), the latched
 ``inertia``, ``/clock`` (optional) and ``/tf`` (optional: world -> body
 frame, and world -> LVLH with an orbit, when tf2_msgs is importable, as on every
 ROS install), and turns each engine item (a
 :class:`~rigid_body_dynamics.engine.body.Snapshot`, a sensor sample) into its
-messages, dispatching by the item's type from one table. With an orbit, odom
+messages, dispatching by the item's type, and a sensor's reading by the
+sensor's name, from one table each. With an orbit, odom
 carries the position (world) and the linear velocity (body frame). All
 messages of one tick carry the snapshot's stamp; vectors are published in the
 user's body frame (``body_frame``) or the world frame (``world_frame``).
@@ -20,8 +21,8 @@ once per publisher with their frame ids, then refilled with each tick's stamp an
 values and published as bytes (a fifth of the cost of publishing message objects).
 """
 
-from geometry_msgs.msg import InertiaStamped, QuaternionStamped, TransformStamped
-from geometry_msgs.msg import Vector3Stamped, WrenchStamped
+from geometry_msgs.msg import InertiaStamped, PoseWithCovarianceStamped, QuaternionStamped
+from geometry_msgs.msg import TransformStamped, Vector3Stamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -31,7 +32,7 @@ from sensor_msgs.msg import Imu, JointState, MagneticField
 
 from . import conversions as conv
 from .prepacked import Prepacked
-from ..engine import ImuSample, MagneticSample, Snapshot
+from ..engine import SensorSample, Snapshot
 from ..physics import quaternions
 from ..physics.environment import lvlh_quaternion
 
@@ -54,6 +55,9 @@ TF_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                     durability=DurabilityPolicy.VOLATILE)
 
 
+#: The position variance (m^2) of a star_tracker message: the position is not measured.
+UNMEASURED = 1e12
+
 #: The state topics besides odom, each of which a node may leave out (``state_topics``).
 OPTIONAL_TOPICS = ('orientation', 'angular_velocity', 'angular_momentum',
                    'angular_momentum_body', 'applied_torque')
@@ -71,15 +75,22 @@ class StatePublisher:
     ``topics``: which of OPTIONAL_TOPICS to publish besides odom (default all);
     ``orbit``: the body has an orbit (odom's position and linear velocity, the
     LVLH frame ``lvlh_frame`` on /tf); ``magnetorquers``: publish
-    ``applied_dipole``; ``magnetometer``: publish ``magnetic_field``.
+    ``applied_dipole``; ``sensors``: the names of the body's sensors ('gyro',
+    'magnetometer', 'star_tracker', 'sun_sensor'), each of which gets its topics.
     """
 
-    def __init__(self, node, frames, publish_imu=True, publish_clock=False, publish_tf=False,
+    def __init__(self, node, frames, publish_clock=False, publish_tf=False,
                  topics=OPTIONAL_TOPICS, wheels=0, orbit=False, lvlh_frame='lvlh',
-                 magnetorquers=False, magnetometer=False):
+                 magnetorquers=False, sensors=()):
         self.world_frame, self.body_frame = frames
-        self._handlers = {Snapshot: self._publish_state, ImuSample: self.publish_imu,
-                          MagneticSample: self.publish_magnetic}
+        self._node = node
+        self._handlers = {Snapshot: self._publish_state, SensorSample: self._publish_sensor}
+        # a sensor's name -> (the method that makes its publishers, the one that publishes)
+        table = {'gyro': (self._make_imu, self.publish_imu),
+                 'magnetometer': (self._make_magnetic, self.publish_magnetic),
+                 'star_tracker': (self._make_star_tracker, self.publish_star_tracker),
+                 'sun_sensor': (self._make_sun_sensor, self.publish_sun_sensor)}
+        self._sensors = {}
         self._orbit = orbit
         qos_opts = QoSOverridingOptions.with_default_policies()
 
@@ -107,25 +118,13 @@ class StatePublisher:
         self._torque = pub(WrenchStamped, 'applied_torque')
         if self._torque is not None:
             self._torque_bytes = _stamped(WrenchStamped(), body, 'wrench.torque')
-        self._imu = pub(Imu, 'imu') if publish_imu else None
-        if publish_imu:
-            self._imu_bias = node.create_publisher(Vector3Stamped, '~/imu_bias', STATE_QOS)
-            imu = Imu()
-            imu.header.frame_id = body
-            imu.linear_acceleration_covariance[0] = -1.0    # not simulated (sensor_msgs/Imu)
-            self._imu_bytes = Prepacked(imu, ('header.stamp', 'orientation', 'angular_velocity',
-                                              'orientation_covariance',
-                                              'angular_velocity_covariance'))
-            self._bias_bytes = _stamped(Vector3Stamped(), body, 'vector')
+        for name in sensors:
+            make, publish = table[name]
+            make(pub)
+            self._sensors[name] = publish
         self._dipole = pub(Vector3Stamped, 'applied_dipole') if magnetorquers else None
         if magnetorquers:
             self._dipole_bytes = _stamped(Vector3Stamped(), body, 'vector')
-        self._magnetic = pub(MagneticField, 'magnetic_field') if magnetometer else None
-        if magnetometer:
-            magnetic = MagneticField()
-            magnetic.header.frame_id = body
-            self._magnetic_bytes = Prepacked(magnetic, ('header.stamp', 'magnetic_field',
-                                                        'magnetic_field_covariance'))
         self._inertia = pub(InertiaStamped, 'inertia', LATCHED_QOS)
         self._wheel_state = pub(JointState, 'wheel_state') if wheels else None
         if wheels:
@@ -151,8 +150,47 @@ class StatePublisher:
             self._tf_bytes = Prepacked(TFMessage(transforms=transforms), tuple(fields))
 
     def publish(self, item):
-        """Publish one engine item (a Snapshot, an ImuSample, a MagneticSample): its topics."""
+        """Publish one engine item (a Snapshot, a SensorSample): its topics."""
         self._handlers[type(item)](item)
+
+    def _publish_sensor(self, sample):
+        """Publish a SensorSample on its sensor's topics."""
+        self._sensors[sample.sensor](sample.stamp_ns, sample.reading)
+
+    # ------------------------------------------------------------------ sensors
+    def _make_imu(self, pub):
+        """Make the gyro's publishers: imu (REP 145) and ~/imu_bias."""
+        body = self.body_frame
+        self._imu = pub(Imu, 'imu')
+        self._imu_bias = self._node.create_publisher(Vector3Stamped, '~/imu_bias', STATE_QOS)
+        imu = Imu()
+        imu.header.frame_id = body
+        imu.linear_acceleration_covariance[0] = -1.0    # not simulated (sensor_msgs/Imu)
+        self._imu_bytes = Prepacked(imu, ('header.stamp', 'orientation', 'angular_velocity',
+                                          'orientation_covariance',
+                                          'angular_velocity_covariance'))
+        self._bias_bytes = _stamped(Vector3Stamped(), body, 'vector')
+
+    def _make_magnetic(self, pub):
+        """Make the magnetometer's publisher: magnetic_field (body frame)."""
+        self._magnetic = pub(MagneticField, 'magnetic_field')
+        magnetic = MagneticField()
+        magnetic.header.frame_id = self.body_frame
+        self._magnetic_bytes = Prepacked(magnetic, ('header.stamp', 'magnetic_field',
+                                                    'magnetic_field_covariance'))
+
+    def _make_star_tracker(self, pub):
+        """Make the star tracker's publisher: star_tracker (world frame, orientation only)."""
+        self._star = pub(PoseWithCovarianceStamped, 'star_tracker')
+        msg = PoseWithCovarianceStamped()
+        msg.header.frame_id = self.world_frame
+        self._star_bytes = Prepacked(msg, ('header.stamp', 'pose.pose.orientation',
+                                           'pose.covariance'))
+
+    def _make_sun_sensor(self, pub):
+        """Make the sun sensor's publisher: sun_sensor (body frame, unit vector)."""
+        self._sun = pub(Vector3Stamped, 'sun_sensor')
+        self._sun_bytes = _stamped(Vector3Stamped(), self.body_frame, 'vector')
 
     def _publish_state(self, snapshot):
         """Publish a Snapshot's state topics."""
@@ -221,27 +259,47 @@ class StatePublisher:
             node.destroy_publisher(self._tf)
             self._tf = None
 
-    def publish_imu(self, sample):
+    def publish_imu(self, stamp_ns, reading):
         """
-        Publish sensor_msgs/Imu (REP 145) and ~/imu_bias from an engine ImuSample.
+        Publish sensor_msgs/Imu (REP 145) and ~/imu_bias from a GyroReading stamped stamp_ns.
 
         Covariances: angular velocity N^2 * rate on the diagonal (the white noise
         per sample; the bias is published apart on ~/imu_bias), orientation the
         orientation noise variance; linear acceleration -1 in element 0 (not
         simulated, as sensor_msgs/Imu says).
         """
-        if self._imu is None:
-            return
-        rate, orientation = (sample.rate_variance,) * 3, (sample.orientation_variance,) * 3
+        rate, orientation = (reading.rate_variance,) * 3, (reading.orientation_variance,) * 3
         self._imu.publish(self._imu_bytes.pack(
-            sample.stamp_ns, sample.q_body, sample.omega_body,
+            stamp_ns, reading.q_body, reading.omega_body,
             _diagonal(orientation), _diagonal(rate)))
-        self._imu_bias.publish(self._bias_bytes.pack(sample.stamp_ns, sample.bias_body))
+        self._imu_bias.publish(self._bias_bytes.pack(stamp_ns, reading.bias_body))
 
-    def publish_magnetic(self, sample):
-        """Publish sensor_msgs/MagneticField (T, body frame) from an engine MagneticSample."""
+    def publish_magnetic(self, stamp_ns, reading):
+        """Publish sensor_msgs/MagneticField (T, body frame) from a MagnetometerReading."""
         self._magnetic.publish(self._magnetic_bytes.pack(
-            sample.stamp_ns, sample.field_body, _diagonal((sample.variance,) * 3)))
+            stamp_ns, reading.field, _diagonal((reading.variance,) * 3)))
+
+    def publish_star_tracker(self, stamp_ns, reading):
+        """
+        Publish geometry_msgs/PoseWithCovarianceStamped from a StarTrackerReading.
+
+        The orientation is the measured body attitude in the world frame; its
+        covariance (rad^2, about the world's fixed axes) fills the lower right 3 x
+        3 block; the position is not measured: 0, with UNMEASURED on its diagonal.
+        """
+        c = reading.covariance
+        u = UNMEASURED
+        cov = (u, 0.0, 0.0, 0.0, 0.0, 0.0,
+               0.0, u, 0.0, 0.0, 0.0, 0.0,
+               0.0, 0.0, u, 0.0, 0.0, 0.0,
+               0.0, 0.0, 0.0, c[0], c[1], c[2],
+               0.0, 0.0, 0.0, c[3], c[4], c[5],
+               0.0, 0.0, 0.0, c[6], c[7], c[8])
+        self._star.publish(self._star_bytes.pack(stamp_ns, reading.q, cov))
+
+    def publish_sun_sensor(self, stamp_ns, reading):
+        """Publish geometry_msgs/Vector3Stamped (unit, body frame) from a SunSensorReading."""
+        self._sun.publish(self._sun_bytes.pack(stamp_ns, reading.direction))
 
     def publish_inertia(self, inertia, stamp_ns):
         """Publish the latched inertia tensor (kg m^2, body frame; the mass is not modelled)."""

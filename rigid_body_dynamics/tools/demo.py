@@ -108,6 +108,7 @@ def _satellite_body():
     from ..engine import BodySimulation, Disturbances
     from ..physics import Inertia
     from ..physics.environment import DipoleField, KeplerOrbit
+    from ..physics.sensors import Magnetometer
     s = SATELLITE_SCENE
     every = round(s['integration_rate'] * s['control_period'])
     return BodySimulation(
@@ -116,7 +117,7 @@ def _satellite_body():
         publish_every=every, disturbances=Disturbances(
             orbit=KeplerOrbit(s['orbit_elements']), field=DipoleField(), gravity_gradient=True),
         magnetorquers=tuple(s['magnetorquer_max_dipole']),
-        magnetometer=(0.0, (0.0, 0.0, 0.0)), magnetometer_every=every)
+        sensors=[Magnetometer(1.0 / s['control_period'])])
 
 
 def satellite_offline():

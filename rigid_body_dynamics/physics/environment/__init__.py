@@ -4,14 +4,17 @@ The space environment (no ROS): a Kepler orbit, Earth's dipole field, and torque
 :mod:`.orbit` (two-body orbit, LVLH frame), :mod:`.magnetic_field` (the
 centred tilted dipole), :mod:`.torque_models` (the torque-model protocol:
 gravity gradient, magnetic dipoles, magnetorquers) and :mod:`.space`
-(:class:`SpaceEnvironment`: what the integrators evaluate at every stage).
+(:class:`SpaceEnvironment`: what the integrators evaluate at every stage) and
+:mod:`.sun` (the Sun's direction and the Earth's shadow).
 """
 
 from .magnetic_field import DipoleField, EARTH_RATE, IGRF13_2020, R_REF
 from .orbit import circular_elements, KeplerOrbit, lvlh_axes, lvlh_quaternion, MU_EARTH, R_EARTH
 from .space import SpaceEnvironment, Surroundings
+from .sun import in_shadow, julian_date, Sun, sun_direction_almanac
 from .torque_models import GravityGradient, MagneticDipole, Magnetorquers
 
 __all__ = ['circular_elements', 'DipoleField', 'EARTH_RATE', 'GravityGradient', 'IGRF13_2020',
            'KeplerOrbit', 'lvlh_axes', 'lvlh_quaternion', 'MagneticDipole', 'Magnetorquers',
-           'MU_EARTH', 'R_EARTH', 'R_REF', 'SpaceEnvironment', 'Surroundings']
+           'MU_EARTH', 'R_EARTH', 'R_REF', 'SpaceEnvironment', 'Sun', 'sun_direction_almanac',
+           'Surroundings', 'in_shadow', 'julian_date']

@@ -35,6 +35,7 @@ blocks (:meth:`GyroModel.sample`).
 
 from dataclasses import dataclass
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -81,17 +82,20 @@ class GyroModel:
     """
     A seeded gyro sampling at ``rate`` Hz with :class:`GyroErrors` ``errors``.
 
+    Draws from ``rng`` when given (a numpy Generator), else from its own
+    generator seeded ``seed``.
+
     ``bias`` is the current true bias (rad/s, body frame, 3 axes), for
     estimator evaluation.
     """
 
-    def __init__(self, errors, rate, seed=0):
+    def __init__(self, errors, rate, seed=0, rng=None):
         if not (rate > 0.0 and math.isfinite(rate)):
             raise ValueError(f'rate must be positive and finite, got {rate!r}')
         self.errors = errors
         self.rate = float(rate)
         self.dt = 1.0 / self.rate
-        self._rng = np.random.default_rng(seed)
+        self._rng = np.random.default_rng(seed) if rng is None else rng
         self._white = errors.noise_density / math.sqrt(self.dt)
         tau, k = errors.correlation_time, errors.bias_random_walk
         if tau > 0.0:
@@ -196,6 +200,51 @@ class GyroModel:
         axis = v / angle if angle > 0.0 else np.array([1.0, 0.0, 0.0])
         return quaternions.multiply(np.asarray(q, dtype=float),
                                     quaternions.from_axis_angle(axis, angle))
+
+
+class GyroReading(NamedTuple):
+    """
+    One IMU reading, body frame: the reported attitude ``q_body`` (x, y, z, w).
+
+    Also the measured rate ``omega_body`` (rad/s), the true ``bias_body`` in it
+    (rad/s), and the ``rate_variance`` (rad/s)^2 and ``orientation_variance``
+    (rad^2) per axis that the Imu message's covariances carry.
+    """
+
+    q_body: tuple
+    omega_body: tuple
+    bias_body: tuple
+    rate_variance: float
+    orientation_variance: float
+
+
+class Gyro:
+    """
+    The gyro as a sensor on the protocol of :mod:`.base`: :class:`GyroErrors` at ``rate`` Hz.
+
+    Its stream is the seed alone (``stream`` None), as before sensors had streams
+    of their own. :meth:`start` makes its :class:`GyroModel` at the rate it
+    actually samples at (the turn-on bias is drawn there).
+    """
+
+    name = 'gyro'
+    stream = None
+
+    def __init__(self, errors, rate):
+        if not (rate > 0.0 and math.isfinite(rate)):
+            raise ValueError(f'imu_rate must be positive and finite, got {rate!r}')
+        self.errors, self.rate = errors, float(rate)
+        self.model = None
+
+    def start(self, rng, rate):
+        """Start again: a fresh :class:`GyroModel` at ``rate`` Hz drawing from ``rng``."""
+        self.model = GyroModel(self.errors, rate, rng=rng)
+
+    def sample(self, state, t, rng):
+        """Return a :class:`GyroReading` of ``state`` (its rate first, then its attitude)."""
+        model = self.model
+        q, measured, bias = model.read(state.q, state.omega)
+        return GyroReading(q, measured, bias, model.rate_variance, model.orientation_variance)
 
 
 def allan_deviation(rates, rate, taus):

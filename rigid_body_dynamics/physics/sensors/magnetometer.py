@@ -6,37 +6,51 @@ A three-axis magnetometer: the field in the body frame plus a constant bias and 
 (T; body frame). ``noise`` sigma (T, 1 sigma per axis) and ``bias`` b (T, body
 frame) are the simulator's ``magnetometer_noise`` and ``magnetometer_bias``; the
 covariance a reading reports is sigma^2 on the diagonal (the bias is not in it:
-an estimator must calibrate it). Seeded: the same seed gives the same stream,
-and a stream of its own, so turning the magnetometer on does not change the
-gyro's noise.
+an estimator must calibrate it). A sensor on the protocol of :mod:`.base`, with
+a stream of its own (``stream`` 1), so turning the magnetometer on does not
+change the gyro's noise.
 """
 
-import math
+from typing import NamedTuple
 
-import numpy as np
+from .base import check_rate, check_scalar, check_vector
+from .. import quaternions as quat
+
+
+class MagnetometerReading(NamedTuple):
+    """One reading: ``field`` (T, body frame) and the white noise's ``variance`` (T^2 per axis)."""
+
+    field: tuple
+    variance: float
 
 
 class Magnetometer:
-    """A seeded magnetometer: ``noise`` (T, >= 0), ``bias`` (3, T, body), ``seed`` (int)."""
+    """A magnetometer at ``rate`` Hz: ``noise`` (T, >= 0), ``bias`` (3, T, body)."""
 
-    #: The stream's second seed word: the gyro draws from seed alone.
-    STREAM = 1
+    name = 'magnetometer'
+    stream = 1
 
-    def __init__(self, noise=0.0, bias=(0.0, 0.0, 0.0), seed=0):
-        if not (math.isfinite(noise) and noise >= 0.0):
-            raise ValueError(f'magnetometer_noise must be a finite number >= 0 (T), got {noise!r}')
-        bias = tuple(float(c) for c in bias)
-        if len(bias) != 3 or not all(math.isfinite(c) for c in bias):
-            raise ValueError(f'magnetometer_bias must be three finite numbers (T), got {bias!r}')
-        self.noise, self.bias = float(noise), bias
+    def __init__(self, rate, noise=0.0, bias=(0.0, 0.0, 0.0)):
+        self.rate = check_rate('magnetometer_rate', rate)
+        self.noise = check_scalar('magnetometer_noise', noise, 'T', 1.0)
+        self.bias = check_vector('magnetometer_bias', bias, 'T')
         self.variance = self.noise ** 2
-        self._rng = np.random.default_rng([int(seed), self.STREAM])
 
-    def read(self, field_body):
+    def start(self, rng, rate):
+        """Start (the bias is a parameter: nothing to draw)."""
+
+    def read(self, field_body, rng):
         """Return the measured field (T, body frame, a tuple) for the true ``field_body`` (T)."""
         b = self.bias
         x, y, z = (float(c) for c in field_body)
         if self.noise:
-            n = (self._rng.standard_normal(3) * self.noise).tolist()
+            n = (rng.standard_normal(3) * self.noise).tolist()
             return (x + b[0] + n[0], y + b[1] + n[1], z + b[2] + n[2])
         return (x + b[0], y + b[1], z + b[2])
+
+    def sample(self, state, t, rng):
+        """Return a :class:`MagnetometerReading` of ``state`` at t (s)."""
+        q = state.q
+        b_world = state.sky.field_world(t, state.position)
+        b_body = quat.rotate_components((-q[0], -q[1], -q[2], q[3]), b_world)
+        return MagnetometerReading(self.read(b_body, rng), self.variance)

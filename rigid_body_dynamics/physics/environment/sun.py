@@ -1,0 +1,113 @@
+"""
+The Sun's direction and the Earth's shadow (no ROS).
+
+With an orbit the Sun is where the low-precision solar coordinates of the
+Astronomical Almanac put it (about 0.01 deg, good 1950-2050), at the Julian
+date of ``epoch`` plus the simulated time:
+
+    d = JD - 2451545.0
+    L = 280.460 + 0.9856474 d          (mean longitude, deg)
+    g = 357.528 + 0.9856003 d          (mean anomaly, deg)
+    lambda = L + 1.915 sin g + 0.020 sin 2g
+    eps = 23.439 - 4e-7 d              (obliquity of the ecliptic, deg)
+    s = (cos lambda, cos eps sin lambda, sin eps sin lambda)
+
+a unit vector in the world frame (equatorial, z along the Earth's rotation
+axis, x towards the equinox), seen from the Earth's centre: the parallax of a
+low orbit (under 5e-5 rad) is neglected. The epoch is UTC, and TT is taken as
+UTC (they differ by about 69 s, 0.0007 deg of the Sun's motion).
+
+The Earth's shadow is a cylinder of the planet's radius behind the Earth
+(no penumbra): a body at r is in eclipse when r . s < 0 and its distance from
+the Earth-Sun line is under the radius.
+"""
+
+from datetime import datetime, timezone
+import math
+
+#: The Julian date of the Unix epoch, 1970-01-01T00:00:00Z.
+JD_UNIX = 2440587.5
+#: The Julian date of J2000.0, 2000-01-01T12:00:00 (TT).
+JD_J2000 = 2451545.0
+_DAY = 86400.0
+
+
+def julian_date(epoch):
+    """
+    Return the Julian date (days) of an ISO 8601 UTC time, e.g. '2026-03-20T12:00:00Z'.
+
+    A time without an offset is taken as UTC; one with an offset is converted.
+    Refuses (ValueError naming ``epoch``) what ``datetime.fromisoformat`` cannot read.
+    """
+    text = str(epoch).strip()
+    if text.endswith(('Z', 'z')):          # (fromisoformat reads Z from Python 3.11 only)
+        text = text[:-1] + '+00:00'
+    try:
+        when = datetime.fromisoformat(text)
+    except ValueError:
+        raise ValueError(f'epoch must be an ISO 8601 UTC time such as 2026-03-20T12:00:00Z, '
+                         f'got {epoch!r}') from None
+    if when.tzinfo is None:
+        when = when.replace(tzinfo=timezone.utc)
+    return JD_UNIX + when.timestamp() / _DAY
+
+
+def sun_direction_almanac(jd):
+    """
+    Return the unit vector to the Sun (world frame) at Julian date ``jd`` (days, TT ~ UTC).
+
+    The Astronomical Almanac's low-precision formula (module docstring), seen from
+    the Earth's centre.
+    """
+    d = jd - JD_J2000
+    g = math.radians((357.528 + 0.9856003 * d) % 360.0)
+    lam = math.radians((280.460 + 0.9856474 * d) % 360.0
+                       + 1.915 * math.sin(g) + 0.020 * math.sin(2.0 * g))
+    eps = math.radians(23.439 - 4e-7 * d)
+    s = math.sin(lam)
+    return (math.cos(lam), math.cos(eps) * s, math.sin(eps) * s)
+
+
+class Sun:
+    """
+    The Sun's direction over simulated time: from ``epoch`` (ISO 8601 UTC), or ``fixed``.
+
+    ``fixed`` (a world unit vector; normalised here) is used when there is no
+    epoch (a body without an orbit). Refuses a zero or non-finite direction and
+    an unreadable epoch, naming the parameter.
+    """
+
+    def __init__(self, epoch=None, fixed=(1.0, 0.0, 0.0)):
+        self.epoch = epoch
+        self.jd0 = None if epoch is None else julian_date(epoch)
+        if self.jd0 is None:
+            try:
+                v = tuple(float(c) for c in fixed)
+            except (TypeError, ValueError):
+                v = ()
+            n = math.sqrt(sum(c * c for c in v)) if len(v) == 3 else 0.0
+            if not (math.isfinite(n) and n > 0.0):
+                raise ValueError('sun_direction must be three finite numbers, not all zero, '
+                                 f'got {fixed!r}')
+            self.fixed = (v[0] / n, v[1] / n, v[2] / n)
+        else:
+            self.fixed = None
+
+    def direction(self, t):
+        """Return the unit vector to the Sun (world frame) at simulated time t (s)."""
+        if self.fixed is not None:
+            return self.fixed
+        return sun_direction_almanac(self.jd0 + t / _DAY)
+
+
+def in_shadow(r, sun, radius):
+    """
+    Tell whether position ``r`` (m, world) is in the cylindrical shadow of a planet.
+
+    ``sun`` is the unit vector to the Sun (world), ``radius`` (m) the planet's.
+    """
+    along = r[0] * sun[0] + r[1] * sun[1] + r[2] * sun[2]
+    if along >= 0.0:
+        return False
+    across2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] - along * along
+    return across2 < radius * radius
