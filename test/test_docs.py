@@ -124,7 +124,10 @@ def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs
                                                     '-p', 'orbit_elements:=[7.0e6, 0.0, 0.0, '
                                                     '0.0, 0.0, 0.0]',
                                                     '-p', 'magnetic_field_model:=dipole',
-                                                    '-p', 'magnetometer_rate:=10.0']),
+                                                    '-p', 'magnetometer_rate:=10.0',
+                                                    '-p', 'epoch:=2026-03-20T12:00:00Z',
+                                                    '-p', 'star_tracker_rate:=10.0',
+                                                    '-p', 'sun_sensor_rate:=10.0']),
                'attitude_analyzer': ('analyzer', []), 'poinsot_visualizer': ('poinsot', []),
                'attitude_controller': ('controller', [
                    '-p', 'actuator:=wheels', '-p', 'wheel_axes:=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, '

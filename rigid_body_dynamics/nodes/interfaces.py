@@ -136,6 +136,15 @@ SIMULATOR = Interfaces('attitude_simulator', [
               'The magnetometer at `magnetometer_rate`: the field (T, `body_frame`) plus '
               '`magnetometer_bias` and white noise; covariance noise^2 on the diagonal.',
               'if `magnetometer_rate` > 0'),
+    Interface('pub', 'star_tracker', 'geometry_msgs/msg/PoseWithCovarianceStamped',
+              'The star tracker at `star_tracker_rate`: the measured body attitude in '
+              '`world_frame` and its orientation covariance (rad^2, about the world axes); the '
+              'position is not measured (0, variance 1e12 m^2). None while the Sun or the Earth '
+              'blocks the view (counted on /diagnostics).', 'if `star_tracker_rate` > 0'),
+    Interface('pub', 'sun_sensor', 'geometry_msgs/msg/Vector3Stamped',
+              'The sun sensor at `sun_sensor_rate`: the unit Sun direction (`body_frame`) with '
+              '`sun_sensor_noise`; none outside `sun_sensor_fov` or in eclipse (counted).',
+              'if `sun_sensor_rate` > 0'),
     Interface('pub', 'imu', 'sensor_msgs/msg/Imu',
               'REP 145 gyro at `imu_rate`: measured angular velocity and orientation with the '
               'gyro error model and their covariances; no acceleration (covariance[0] = -1).',
