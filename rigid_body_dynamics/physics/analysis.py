@@ -26,8 +26,9 @@ import numpy as np
 
 from . import equations, estimators, quaternions, theory
 from .environment.libration import jacobi_integral, libration_modes, oscillation_frequencies
-from .findings import (ConservationFindings, ERROR, Findings, OK, OrbitFindings,
-                       PrecessionFindings, Quantity, StabilityFindings, UNAVAILABLE, WARN)
+from .findings import (ConservationFindings, ERROR, EstimationFindings, Findings, OK,
+                       OrbitFindings, PrecessionFindings, Quantity, StabilityFindings,
+                       UNAVAILABLE, WARN)
 from .findings_render import quantity_lines
 from .inertia import as_inertia
 from .tolerances import compare, level, Tolerances, unavailable, worst
@@ -561,3 +562,81 @@ def _stability(t, w, moments, inertia, tol, precession=None, torque_why=None):
                              wobble_theory, 'rad/s')
     return StabilityFindings(OK, f'spin about axis {st.axis + 1} is {st.kind}',
                              wobble_frequency=wobble, **common)
+
+
+#: Fewer matched estimates than this and the estimation check is unavailable.
+MIN_ESTIMATES = 30
+
+
+def autocorrelation_time(x, c=5.0):
+    """
+    Return the integrated autocorrelation time (samples) of the series x (N,) or (N, m).
+
+    tau = 1 + 2 sum_k rho_k, summed up to Sokal's automatic window (the first
+    lag M >= c tau(M)); columns are averaged. 1 for white noise; the variance of
+    a mean of N correlated samples is tau times that of N independent ones.
+    """
+    x = np.asarray(x, dtype=float)
+    x = x.reshape(len(x), -1) - x.reshape(len(x), -1).mean(axis=0)
+    n = len(x)
+    size = 1 << (2 * n - 1).bit_length()
+    f = np.fft.rfft(x, size, axis=0)
+    acf = np.fft.irfft(f * np.conj(f), size, axis=0)[:n].mean(axis=1)
+    if acf[0] <= 0.0:
+        return 1.0
+    taus = 2.0 * np.cumsum(acf / acf[0]) - 1.0
+    window = np.arange(n) >= c * taus
+    m = int(np.argmax(window)) if window.any() else n - 1
+    return float(max(1.0, taus[m]))
+
+
+def estimation(q_true, q_est, covariances, bias_true=None, bias_est=None, level=0.95):
+    """
+    Judge attitude estimates against the truth: errors, 3-sigma share, NEES and its verdict.
+
+    ``q_true``, ``q_est`` (N, 4) x, y, z, w body -> world at the same stamps;
+    ``covariances`` (N, 3, 3) the estimates' attitude covariances (rad^2) about
+    the world's fixed axes (as ROS messages have them). The error is the
+    rotation vector of q_est q_true^-1 (world frame). NEES_k = e_k^T P_k^-1 e_k;
+    its mean over N samples of a consistent estimator is chi-square with 3 N
+    degrees of freedom over N, if the samples are independent. Successive
+    estimates are not: the bounds count N / tau independent samples, tau the
+    integrated autocorrelation time of the whitened errors
+    (:func:`autocorrelation_time`). "Inside 3 sigma": inside the ellipsoid of the
+    covariance that holds 99.73 % (the share of 3 sigma in one dimension).
+    ``bias_true`` and ``bias_est`` (N, 3) rad/s add the bias error's RMS.
+    Returns :class:`EstimationFindings`.
+    """
+    from scipy.stats import chi2
+    n = len(q_true)
+    if n < MIN_ESTIMATES:
+        return EstimationFindings(OK, f'{n} estimates matched to the truth so far (needs '
+                                      f'{MIN_ESTIMATES})', 'unavailable', samples=n)
+    q_t = np.asarray(q_true, dtype=float)
+    q_e = np.asarray(q_est, dtype=float)
+    errors = quaternions.to_rotation_vector(quaternions.multiply(q_e, quaternions.conjugate(q_t)))
+    cov = np.asarray(covariances, dtype=float)
+    chol = np.linalg.cholesky(cov)
+    white = np.linalg.solve(chol, errors[..., None])[..., 0]
+    nees_k = np.sum(white * white, axis=1)
+    tau = autocorrelation_time(white)
+    independent = n / tau
+    low = chi2.ppf((1.0 - level) / 2.0, 3.0 * independent) / independent
+    high = chi2.ppf((1.0 + level) / 2.0, 3.0 * independent) / independent
+    nees = float(np.mean(nees_k))
+    verdict = ('overconfident' if nees > high else 'pessimistic' if nees < low else
+               'consistent')
+    angles = np.linalg.norm(errors, axis=1)
+    bias_rms = None
+    if bias_true is not None and bias_est is not None:
+        d = np.asarray(bias_est, dtype=float) - np.asarray(bias_true, dtype=float)
+        bias_rms = np.sqrt(np.mean(d * d, axis=0))
+    inside = float(np.mean(nees_k <= chi2.ppf(chi2.cdf(9.0, 1), 3)))
+    message = (f'{verdict}: mean NEES {nees:.3g} for 3 expected (95 % interval {low:.3g} to '
+               f'{high:.3g} over {independent:.0f} independent samples of {n}); attitude '
+               f'error {math.sqrt(np.mean(angles ** 2)):.3g} rad RMS')
+    return EstimationFindings(
+        OK if verdict == 'consistent' else WARN, message, verdict, n,
+        np.sqrt(np.mean(errors ** 2, axis=0)), np.max(np.abs(errors), axis=0),
+        float(math.sqrt(np.mean(angles ** 2))), float(np.max(angles)), inside, nees, tau,
+        independent, (float(low), float(high)), bias_rms)

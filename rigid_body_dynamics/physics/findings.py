@@ -146,6 +146,40 @@ class OrbitFindings:
 
 
 @dataclass(frozen=True)
+class EstimationFindings:
+    """
+    An attitude estimate judged against the truth over a window of matched stamps.
+
+    ``samples`` the estimates matched to a true attitude; ``rms`` and ``largest``
+    (3,) the attitude error per world axis (rad) and ``rms_total``, ``largest_total``
+    its angle; ``inside_3_sigma`` the fraction of samples whose error is inside the
+    3-sigma ellipsoid of the reported covariance; ``nees`` the mean normalised
+    estimation error squared (3 for a consistent estimator); ``correlation`` the
+    integrated autocorrelation time (samples) of the whitened errors, and
+    ``independent`` = samples / correlation, the independent samples the bounds
+    count; ``bounds`` the two-sided 95 % chi-square interval of the mean NEES for
+    3 ``independent`` degrees of freedom; ``verdict`` 'consistent', 'overconfident'
+    (NEES above the interval), 'pessimistic' (below) or 'unavailable'. With a
+    bias estimate and the true bias: ``bias_rms`` (3,) rad/s.
+    """
+
+    status: str
+    message: str
+    verdict: str
+    samples: int = 0
+    rms: object = None
+    largest: object = None
+    rms_total: float = math.nan
+    largest_total: float = math.nan
+    inside_3_sigma: float = math.nan
+    nees: float = math.nan
+    correlation: float = math.nan
+    independent: float = math.nan
+    bounds: tuple = (math.nan, math.nan)
+    bias_rms: object = None
+
+
+@dataclass(frozen=True)
 class Findings:
     """Everything :func:`analyse` says about a trajectory (``orbit`` with an orbit)."""
 
