@@ -32,6 +32,7 @@ setup(
             'poinsot_visualizer = rigid_body_dynamics.nodes.entry:poinsot',
             'attitude_fleet = rigid_body_dynamics.nodes.entry:fleet',
             'attitude_controller = rigid_body_dynamics.nodes.entry:controller',
+            'attitude_estimator = rigid_body_dynamics.nodes.entry:estimator',
             'rigid_body_report = rigid_body_dynamics.tools.report:main',
             'rigid_body_analyze = rigid_body_dynamics.tools.analyze:main',
         ],

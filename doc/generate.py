@@ -20,11 +20,12 @@ OUT = os.path.join(HERE, 'reference', 'generated')
 
 def pages():
     """Return {file name: Markdown text} of every generated part."""
-    from rigid_body_dynamics.nodes import analyzer, controller, poinsot, simulator
+    from rigid_body_dynamics.nodes import analyzer, controller, estimator, poinsot, simulator
     from rigid_body_dynamics.nodes.interfaces import NODES
     tables = {'attitude_simulator': simulator.PARAMETERS, 'attitude_analyzer': analyzer.PARAMETERS,
               'poinsot_visualizer': poinsot.PARAMETERS,
-              'attitude_controller': controller.PARAMETERS}
+              'attitude_controller': controller.PARAMETERS,
+              'attitude_estimator': estimator.PARAMETERS}
     out = {}
     for node, interfaces in NODES.items():
         out[f'{node}.md'] = '\n'.join([

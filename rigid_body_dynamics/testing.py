@@ -142,7 +142,7 @@ class SimulatorHandle:
             proc = subprocess.Popen(list(executable) + (['--ros-args', *ros_args]
                                                         if ros_args else []))
         else:
-            module = {'attitude_controller': 'controller',
+            module = {'attitude_controller': 'controller', 'attitude_estimator': 'estimator',
                       'attitude_simulator': 'simulator'}.get(executable, executable)
             proc = start_node(module, ros_args)
         self.started.append(proc)

@@ -20,7 +20,7 @@ import sys
 
 import pytest
 from rcl_interfaces.srv import ListParameters
-from rigid_body_dynamics.nodes import analyzer, controller, poinsot, simulator
+from rigid_body_dynamics.nodes import analyzer, controller, estimator, poinsot, simulator
 from rigid_body_dynamics.nodes.interfaces import NODES
 from rigid_body_dynamics.ros.client import WaitTimeout
 from test_report_browser import _chromium, FLAGS
@@ -129,6 +129,7 @@ def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs
                                                     '-p', 'star_tracker_rate:=10.0',
                                                     '-p', 'sun_sensor_rate:=10.0']),
                'attitude_analyzer': ('analyzer', []), 'poinsot_visualizer': ('poinsot', []),
+               'attitude_estimator': ('estimator', []),
                'attitude_controller': ('controller', [
                    '-p', 'actuator:=wheels', '-p', 'wheel_axes:=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, '
                    '0.0, 0.0, 1.0]', '-p', 'wheel_inertia:=[0.01, 0.01, 0.01]'])}
@@ -136,7 +137,8 @@ def test_the_reference_lists_what_the_running_nodes_have(launch, probe, tf2_msgs
         launch(f'rigid_body_dynamics.nodes.{module}', *args, name=node, env=env)
     tables = {'attitude_simulator': simulator.PARAMETERS, 'attitude_analyzer': analyzer.PARAMETERS,
               'poinsot_visualizer': poinsot.PARAMETERS,
-              'attitude_controller': controller.PARAMETERS}
+              'attitude_controller': controller.PARAMETERS,
+              'attitude_estimator': estimator.PARAMETERS}
     for node, interfaces in NODES.items():
         want = interfaces.resolved('/')    # publish_clock, a wheel, an orbit, a field
 

@@ -121,6 +121,24 @@ def odometry_translation(raws, decode):
             np.array(v, dtype=float).reshape(-1, 3))
 
 
+def pose_covariance_batch(raws, decode):
+    """
+    Return (t_ns, q (N, 4), orientation covariance (N, 3, 3)) of PoseWithCovarianceStamped.
+
+    The orientation covariance is the message's lower right 3 x 3 block (rad^2,
+    about the fixed axes of the header's frame). Decoded one by one.
+    """
+    t, q, cov = [], [], []
+    for raw in raws:
+        msg = decode(raw)
+        o = msg.pose.pose.orientation
+        t.append(stamp_ns(msg.header.stamp))
+        q.append((o.x, o.y, o.z, o.w))
+        cov.append(np.reshape(np.asarray(msg.pose.covariance, dtype=float), (6, 6))[3:, 3:])
+    return (np.array(t, dtype=np.int64), np.array(q, dtype=float).reshape(-1, 4),
+            np.array(cov, dtype=float).reshape(-1, 3, 3))
+
+
 def _unit(q):
     n = float(np.linalg.norm(q))
     return tuple(c / n for c in q) if n > 0.0 and np.isfinite(n) else (0.0, 0.0, 0.0, 1.0)

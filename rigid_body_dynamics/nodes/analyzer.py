@@ -27,7 +27,7 @@ import math
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from geometry_msgs.msg import InertiaStamped, WrenchStamped
+from geometry_msgs.msg import InertiaStamped, PoseWithCovarianceStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.clock import Clock, ClockType
@@ -43,7 +43,7 @@ from .environment_parameters import environment_params
 from .wheel_parameters import wheel_params, wheels_from
 from ..messages import samples
 from ..physics import Inertia
-from ..physics.analysis import analyse, Tolerances, Trajectory
+from ..physics.analysis import analyse, estimation, Tolerances, Trajectory
 from ..ros import conversions as conv
 from ..ros.intake import Intake
 from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
@@ -160,6 +160,7 @@ class SampleBuffer:
         self.torque_t, self.torque = [], []
         self.wheel_t, self.wheel = [], []
         self.orbit_t, self.orbit = [], []
+        self.estimate_t, self.estimate = [], []
 
     def add(self, t, q, w, reset_jump, max_gap):
         """Insert one state sample (stamp t, ns) in stamp order; duplicates are dropped."""
@@ -189,6 +190,18 @@ class SampleBuffer:
     def add_orbit(self, t, position, velocity):
         """Insert one orbit sample (stamp t, ns): position (m) and velocity (m/s), world."""
         _insert(self.orbit_t, self.orbit, t, (tuple(position), tuple(velocity)))
+
+    def add_estimate(self, t, q, covariance):
+        """Insert one attitude estimate (stamp t, ns): q and its covariance (3 x 3, rad^2)."""
+        _insert(self.estimate_t, self.estimate, t, (q, covariance))
+
+    def estimate_arrays(self):
+        """Return (true q, estimated q, covariances) at the stamps both have (may be empty)."""
+        index = {t: i for i, t in enumerate(self.t)}
+        rows = [(index[t], e) for t, e in zip(self.estimate_t, self.estimate) if t in index]
+        return (np.array([self.q[i] for i, _ in rows]).reshape(-1, 4),
+                np.array([e[0] for _, e in rows]).reshape(-1, 4),
+                np.array([e[1] for _, e in rows]).reshape(-1, 3, 3))
 
     def orbit_arrays(self):
         """Return (position, velocity) (N, 3) at the state stamps, or None unless all have one."""
@@ -227,6 +240,8 @@ class SampleBuffer:
         del self.wheel_t[:j], self.wheel[:j]
         j = bisect.bisect_left(self.orbit_t, keep_from)
         del self.orbit_t[:j], self.orbit[:j]
+        j = bisect.bisect_left(self.estimate_t, keep_from)
+        del self.estimate_t[:j], self.estimate[:j]
 
     def arrays(self):
         """(t ns int64, q, omega, torque at the state stamps); torque 0 where none is known."""
@@ -268,6 +283,8 @@ class AttitudeAnalyzer(Node):
         self._intake.subscribe(Odometry, 'odom', INPUT_QOS)
         self._intake.subscribe(WrenchStamped, 'applied_torque', INPUT_QOS)
         self._intake.subscribe(JointState, 'wheel_state', INPUT_QOS)
+        self._intake.subscribe(PoseWithCovarianceStamped, 'attitude_estimate', INPUT_QOS)
+        self._estimates = 0
         self.create_subscription(InertiaStamped, 'inertia', self._on_inertia, LATCHED_QOS)
         self._pub = {name: self.create_publisher(Float64, name, 10) for name in (
             'precession/body_rate', 'precession/lab_rate', 'kinetic_energy',
@@ -354,6 +371,13 @@ class AttitudeAnalyzer(Node):
             for stamp, vec in zip(t.tolist(), tau.tolist()):
                 if all(math.isfinite(c) for c in vec):
                     self._add_torque(stamp, vec)
+        raws = self._intake.take('attitude_estimate')
+        if raws:
+            self._estimates += len(raws)
+            decode = lambda raw: deserialize_message(raw, PoseWithCovarianceStamped)  # noqa
+            for stamp, q, cov in zip(*samples.pose_covariance_batch(raws, decode)):
+                if np.all(np.isfinite(q)) and np.all(np.isfinite(cov)):
+                    self._buffer.add_estimate(int(stamp), q, cov)
         for raw in self._intake.take('wheel_state'):
             msg = deserialize_message(raw, JointState)
             self._buffer.add_wheels(samples.stamp_ns(msg.header.stamp), msg.velocity,
@@ -440,6 +464,9 @@ class AttitudeAnalyzer(Node):
                 if qty is not None and qty.measured is not None:
                     self._publish(topic, qty.measured)
             statuses += diagnostics.statuses(found, name, hw, origin)
+        if self._estimates:
+            statuses.append(diagnostics.estimation_status(
+                estimation(*buf.estimate_arrays()), name, hw))
         array = DiagnosticArray(status=statuses)
         array.header.stamp = self.get_clock().now().to_msg()
         self._pub_diag.publish(array)

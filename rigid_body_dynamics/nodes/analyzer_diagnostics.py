@@ -33,6 +33,12 @@ def statuses(found, name, hardware_id, origin_ns):
             if check in sections]
 
 
+def estimation_status(found, name, hardware_id):
+    """Return the ``estimation`` DiagnosticStatus of EstimationFindings ``found``."""
+    level, message, values = findings_render.estimation_key_values(found)
+    return status(f'{name}: estimation', LEVELS[level], message, values, hardware_id)
+
+
 def findings_from(received):
     """
     Read an analyzer's statuses back into Findings.

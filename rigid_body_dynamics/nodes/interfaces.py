@@ -184,6 +184,10 @@ ANALYZER = Interfaces('attitude_analyzer', [
     Interface('sub', 'wheel_state', 'sensor_msgs/msg/JointState',
               "Reaction wheels' speeds and motor torques at the odom stamps; used with the "
               '`wheel_*` parameters (hidden helper node `_attitude_analyzer_intake`).'),
+    Interface('sub', 'attitude_estimate', 'geometry_msgs/msg/PoseWithCovarianceStamped',
+              "Any estimator's attitude and its covariance (about the world's axes), judged "
+              'against odom at the same stamps: the `estimation` status (hidden helper node '
+              '`_attitude_analyzer_intake`).'),
     Interface('pub', 'precession/body_rate', 'std_msgs/msg/Float64',
               "rad/s: omega about the symmetry axis, body frame (the seed's Omega)."),
     Interface('pub', 'precession/lab_rate', 'std_msgs/msg/Float64',
@@ -192,7 +196,8 @@ ANALYZER = Interfaces('attitude_analyzer', [
     Interface('pub', 'angular_momentum_norm', 'std_msgs/msg/Float64', '|L| (kg m^2/s).'),
     Interface('pub', '/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray',
               'Every `diagnostic_period`: `conservation`, `precession`, `stability`, `input` '
-              '(and `orbit` with `gravity_gradient`: libration and the Jacobi integral).'),
+              '(and `orbit` with `gravity_gradient`: libration and the Jacobi integral; '
+              '`estimation` once an attitude_estimate came).'),
     Interface('srv', '~/reset_baseline', 'std_srvs/srv/Trigger',
               'Measure drift from the next sample on.'),
 ])
@@ -224,5 +229,30 @@ CONTROLLER = Interfaces('attitude_controller', [
               'if `actuator` is wheels'),
 ])
 
+ESTIMATOR = Interfaces('attitude_estimator', [
+    Interface('sub', 'imu', 'sensor_msgs/msg/Imu',
+              'The gyro: its angular_velocity propagates the estimate (the orientation is '
+              'not used).'),
+    Interface('sub', 'star_tracker', 'geometry_msgs/msg/PoseWithCovarianceStamped',
+              'Attitude readings; the first starts the filter. Weighted by '
+              '`star_tracker_noise` and `star_tracker_orientation`, not by the covariance '
+              'the message carries.'),
+    Interface('sub', 'sun_sensor', 'geometry_msgs/msg/Vector3Stamped',
+              'Sun directions (body frame) against the Sun of `epoch` / `sun_direction`; '
+              'used when `sun_sensor_noise` > 0.'),
+    Interface('sub', 'magnetic_field', 'sensor_msgs/msg/MagneticField',
+              'The field (body frame) against the dipole model on the orbit; used with '
+              '`magnetic_field_model` dipole and `magnetometer_noise` > 0.'),
+    Interface('pub', 'attitude_estimate', 'geometry_msgs/msg/PoseWithCovarianceStamped',
+              'The estimate at every gyro stamp (one gyro sample late): orientation in '
+              '`world_frame`, its covariance about the world axes (rad^2); position not '
+              'estimated (0, variance 1e12 m^2).'),
+    Interface('pub', '~/gyro_bias_estimate', 'geometry_msgs/msg/Vector3Stamped',
+              "The gyro bias estimate (rad/s, `body_frame`) at the estimate's stamp."),
+    Interface('pub', '/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray',
+              '1 Hz: `<node>: filter` (its sigmas, the bias, readings used, late readings '
+              'dropped, restarts).'),
+])
+
 #: Every node's table, by executable name.
-NODES = {t.node: t for t in (SIMULATOR, ANALYZER, POINSOT, CONTROLLER)}
+NODES = {t.node: t for t in (SIMULATOR, ANALYZER, POINSOT, CONTROLLER, ESTIMATOR)}

@@ -568,13 +568,18 @@ def _stability(t, w, moments, inertia, tol, precession=None, torque_why=None):
 MIN_ESTIMATES = 30
 
 
-def autocorrelation_time(x, c=5.0):
+def autocorrelation_time(x, c=5.0, batches=10):
     """
     Return the integrated autocorrelation time (samples) of the series x (N,) or (N, m).
 
-    tau = 1 + 2 sum_k rho_k, summed up to Sokal's automatic window (the first
-    lag M >= c tau(M)); columns are averaged. 1 for white noise; the variance of
-    a mean of N correlated samples is tau times that of N independent ones.
+    The larger of two estimates, so that neither short nor rare long correlations
+    are missed: tau = 1 + 2 sum_k rho_k summed up to Sokal's automatic window (the
+    first lag M >= c tau(M); columns averaged), which sees the correlation of the
+    steady state but cuts off long excursions (an estimator coasting without
+    measurements for a while); and the batch-means estimate, ``batches`` equal
+    batches' mean variance times their length over the series' variance, which
+    sees those. 1 for white noise; the variance of a mean of N correlated samples
+    is tau times that of N independent ones.
     """
     x = np.asarray(x, dtype=float)
     x = x.reshape(len(x), -1) - x.reshape(len(x), -1).mean(axis=0)
@@ -587,7 +592,11 @@ def autocorrelation_time(x, c=5.0):
     taus = 2.0 * np.cumsum(acf / acf[0]) - 1.0
     window = np.arange(n) >= c * taus
     m = int(np.argmax(window)) if window.any() else n - 1
-    return float(max(1.0, taus[m]))
+    size = n // batches
+    means = x[:size * batches].reshape(batches, size, -1).mean(axis=1)
+    batch_tau = size * float(np.mean(means.var(axis=0, ddof=1))) / float(
+        np.mean(x.var(axis=0))) if size > 1 else 1.0
+    return float(max(1.0, taus[m], batch_tau))
 
 
 def estimation(q_true, q_est, covariances, bias_true=None, bias_est=None, level=0.95):

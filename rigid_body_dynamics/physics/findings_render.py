@@ -85,7 +85,24 @@ OTHER_KEYS = (
     ('orbit', 'largest angle from LVLH (rad)', 'over the window'),
     ('orbit', 'Jacobi integral drift (rel.)', 'largest |E - E0| / |E0| over the window'),
     ('orbit', 'Jacobi tolerance', 'the tolerance it was checked against (the energy one)'),
-)
+) + tuple(('estimation', key, meaning) for key, meaning in (
+    ('verdict', '`consistent`, `overconfident` (NEES above its interval), `pessimistic` '
+     '(below) or `unavailable`'),
+    ('estimates matched', 'attitude_estimate samples in the window with an odom of the same '
+     'stamp'),
+    ('attitude error RMS (rad)', 'the angle of q_est q_true^-1, RMS over the window'),
+    ('attitude error max (rad)', 'its largest value'),
+    ('attitude error RMS per world axis (rad)', 'the rotation vector of the error, per axis'),
+    ('attitude error max per world axis (rad)', 'its largest magnitude per axis'),
+    ('fraction inside 3 sigma', "the share of errors inside the covariance's 99.73 % "
+     'ellipsoid'),
+    ('mean NEES', 'e^T P^-1 e averaged over the window (3 when consistent)'),
+    ('NEES 95 % interval', 'the chi-square interval of the mean NEES for the independent '
+     'samples'),
+    ('correlation time (samples)', 'the integrated autocorrelation time of the whitened '
+     'errors'),
+    ('independent samples', 'estimates matched / correlation time: what the interval counts'),
+))
 #: What each quantity is, for the manual.
 MEANINGS = {
     'body_rate': "axisymmetric: omega turning about the symmetry axis in the body (the seed's "
@@ -114,7 +131,7 @@ def reference_rows():
              for mode, field, key in CONSERVATION]
     rows += [(sec, key, meaning) for sec, key, meaning in OTHER_KEYS
              if sec == 'conservation' and key not in ('mode', 'baseline stamp (s)')]
-    for section in ('precession', 'stability', 'orbit'):
+    for section in ('precession', 'stability', 'orbit', 'estimation'):
         rows += [(sec, key, meaning) for sec, key, meaning in OTHER_KEYS if sec == section]
         for sec, field, key, _text in QUANTITIES:
             if sec != section:
@@ -266,6 +283,22 @@ def quantity_values(label, qty):
     if qty.relative_error is not None:
         out += [(f'{label} error (rel.)', qty.relative_error), (f'{label} status', qty.status)]
     return out
+
+
+def estimation_key_values(e):
+    """Return (status, message, [(key, value)]) of EstimationFindings ``e`` (keys as listed)."""
+    values = [('verdict', e.verdict), ('estimates matched', e.samples)]
+    if e.verdict != 'unavailable':
+        values += [('attitude error RMS (rad)', e.rms_total),
+                   ('attitude error max (rad)', e.largest_total),
+                   ('attitude error RMS per world axis (rad)', [float(c) for c in e.rms]),
+                   ('attitude error max per world axis (rad)',
+                    [float(c) for c in e.largest]),
+                   ('fraction inside 3 sigma', e.inside_3_sigma), ('mean NEES', e.nees),
+                   ('NEES 95 % interval', list(e.bounds)),
+                   ('correlation time (samples)', e.correlation),
+                   ('independent samples', e.independent)]
+    return e.status, e.message, values
 
 
 def key_values(found, origin_ns=0):

@@ -9,8 +9,9 @@ dtheta a small rotation vector in the body frame, and its covariance P (6 x 6,
 rad^2 and (rad/s)^2). After each update the error is moved into q and b and
 reset to zero: the multiplicative step that keeps q a unit quaternion.
 
-Propagation over dt with the gyro's rate omega_m (the mean of the readings at
-either end of the interval), omega = omega_m - b:
+Propagation over dt with the gyro's rate omega_m (the reading at the start of
+the interval, held: each reading's white noise then enters one interval, as the
+process noise Q counts it), omega = omega_m - b:
 
     q <- q (x) exp(omega dt / 2)
     Phi = [[R(omega dt)^T, -(I dt - [omega x] dt^2 / 2)], [0, I]]

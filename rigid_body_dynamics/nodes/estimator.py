@@ -1,0 +1,276 @@
+"""
+attitude_estimator: an example attitude estimator (a multiplicative EKF) for the simulator's sensors.
+
+It fuses the gyro (``imu``'s angular velocity) with the ``star_tracker`` and,
+where they publish, the ``sun_sensor`` and the magnetometer (``magnetic_field``)
+against the Sun and field models it is configured with
+(:class:`~rigid_body_dynamics.physics.mekf.MEKF`, ROS-free). Its noise
+parameters have the simulator's sensor parameter names, so one parameters file
+with a ``/**`` section configures both, and a node section can detune the
+estimator. It starts at the first star tracker reading.
+
+Messages are taken in stamp order, not arrival order: every reading waits until
+a gyro sample with a later stamp has come, so the estimate at a stamp is
+published one gyro sample later (the stamp is the state's, not the arrival's).
+A reading older than the estimate it would correct is dropped and counted.
+The Sun and field models need stamps in simulated time (the simulator's
+``publish_clock: true``): the Sun moves with ``epoch`` plus the stamp, and the
+field with the Earth's rotation and the orbit (``orbit_elements``). The
+magnetometer's bias is not estimated.
+
+Publishes ``attitude_estimate`` (geometry_msgs/PoseWithCovarianceStamped,
+``world_frame``: the orientation and its covariance about the world's fixed
+axes; the position is not estimated: 0, variance 1e12 m^2) and
+``~/gyro_bias_estimate`` (geometry_msgs/Vector3Stamped, rad/s, ``body_frame``)
+at every gyro stamp, and a ``filter`` status on /diagnostics.
+"""
+
+import heapq
+import math
+import sys
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import PoseWithCovarianceStamped, Vector3Stamped
+import numpy as np
+from rclpy.node import Node
+from sensor_msgs.msg import Imu, MagneticField
+
+from .environment_parameters import environment_params, orbit_from
+from .sensor_parameters import sensor_params, sun_from
+from .simulator_parameters import PARAMETERS as SIMULATOR
+from ..physics import quaternions as quat
+from ..physics.environment import DipoleField
+from ..physics.mekf import MEKF
+from ..ros import conversions as conv
+from ..ros.parameters import ConfigurationError, Param, ParameterTable
+from ..ros.runner import run
+from ..ros.state_publisher import STATE_QOS, UNMEASURED
+
+NODE_NAME = 'attitude_estimator'
+#: Order of the kinds of message at one stamp: the gyro first (propagate), then the updates.
+_GYRO, _UPDATE = 0, 1
+
+
+def _models(values, out):
+    """Cross-check: the orbit, the Sun and the field the vector readings are compared with."""
+    out['orbit'] = orbit_from(out)
+    out['sun'] = sun_from(out, out['orbit'])
+    out['field'] = None
+    if out['magnetic_field_model'] == 'dipole':
+        if out['orbit'] is None:
+            raise ConfigurationError('magnetic_field_model dipole needs orbit_elements')
+        try:
+            out['field'] = DipoleField(out['magnetic_dipole_coefficients'],
+                                       out['earth_rotation_angle'], out['earth_rotation_rate'])
+        except ValueError as err:
+            raise ConfigurationError(str(err)) from None
+    q = out['star_tracker_orientation']
+    norm = math.sqrt(sum(c * c for c in q))
+    if abs(norm - 1.0) > 1e-6:
+        raise ConfigurationError('star_tracker_orientation must be a unit quaternion (x, y, z, '
+                                 f'w), got {list(q)}')
+    if any(not (0.0 <= c <= 1.0) for c in out['star_tracker_noise']):
+        raise ConfigurationError('star_tracker_noise must be in [0, 1] rad per axis, got '
+                                 f'{list(out["star_tracker_noise"])}')
+    mount = quat.matrix(tuple(c / norm for c in q))
+    noise = np.diag([max(c, 1e-12) ** 2 for c in out['star_tracker_noise']])
+    out['tracker_covariance'] = mount @ noise @ mount.T        # body frame
+
+
+def _simulator(name):
+    return SIMULATOR.params[name]
+
+
+#: The parameters of attitude_estimator (the manual's table is made from this; test_docs checks).
+PARAMETERS = ParameterTable([
+    _simulator('world_frame'), _simulator('body_frame'),
+    _simulator('gyro_noise_density'), _simulator('gyro_bias_random_walk'),
+    _simulator('gyro_turn_on_bias'),
+    *sensor_params('epoch', 'sun_direction', 'star_tracker_noise', 'star_tracker_orientation',
+                   'sun_sensor_noise'),
+    *environment_params('orbit_elements', 'orbit_mu', 'planet_radius', 'magnetic_field_model',
+                        'magnetic_dipole_coefficients', 'earth_rotation_angle',
+                        'earth_rotation_rate', 'magnetometer_noise'),
+    Param('initial_bias_sigma', 'double', 0.0, '0.0 rad/s',
+          'The bias estimate starts at 0 with this 1 sigma per axis; 0 = gyro_turn_on_bias.',
+          low=0.0, high=1.0, read_only=True),
+], cross_checks=(_models,))
+
+
+class AttitudeEstimator(Node):
+    """The attitude_estimator node; ``kwargs`` go to rclpy's Node."""
+
+    def __init__(self, **kwargs):
+        super().__init__(NODE_NAME, **kwargs)
+        v = self._values = PARAMETERS.validate(PARAMETERS.declare(self))
+        self._world, self._body = v['world_frame'], v['body_frame']
+        self._bias_sigma = v['initial_bias_sigma'] or v['gyro_turn_on_bias']
+        self._pending = []            # heap of (stamp ns, kind order, sequence, kind, data)
+        self._sequence = 0
+        self.counts = dict.fromkeys(('gyro', 'star_tracker', 'sun_sensor', 'magnetometer',
+                                     'late', 'restarts'), 0)
+        self._restart()
+        self._pub = self.create_publisher(PoseWithCovarianceStamped, 'attitude_estimate',
+                                          STATE_QOS)
+        self._pub_bias = self.create_publisher(Vector3Stamped, '~/gyro_bias_estimate',
+                                               STATE_QOS)
+        self._pub_diag = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self.create_subscription(Imu, 'imu', self._on_imu, STATE_QOS)
+        self.create_subscription(PoseWithCovarianceStamped, 'star_tracker',
+                                 lambda m: self._queue(m, 'star_tracker'), STATE_QOS)
+        self.create_subscription(Vector3Stamped, 'sun_sensor',
+                                 lambda m: self._queue(m, 'sun_sensor'), STATE_QOS)
+        self.create_subscription(MagneticField, 'magnetic_field',
+                                 lambda m: self._queue(m, 'magnetometer'), STATE_QOS)
+        self.create_timer(1.0, self._diagnose)
+        estimate = PoseWithCovarianceStamped()
+        estimate.header.frame_id = self._world
+        self._estimate = estimate
+        self.get_logger().info(
+            f'MEKF: gyro N = {v["gyro_noise_density"]:g} rad/s/sqrt(Hz), K = '
+            f'{v["gyro_bias_random_walk"]:g} rad/s^2/sqrt(Hz); star tracker noise '
+            f'{list(v["star_tracker_noise"])} rad; waiting for the first star_tracker reading')
+
+    def _restart(self):
+        """Forget the estimate (at start, and when the stamps go back: a simulator reset)."""
+        v = self._values
+        self.filter = MEKF(v['gyro_noise_density'], v['gyro_bias_random_walk'])
+        self._time = None          # the filter's stamp (ns)
+        self._gyro = None          # (stamp ns, measured rate) of the last gyro sample
+        self._newest = None
+
+    # ---------------------------------------------------------------- intake
+    def _queue(self, msg, kind):
+        stamp = conv.time_ns(msg.header.stamp)
+        heapq.heappush(self._pending, (stamp, _UPDATE, self._sequence, kind, msg))
+        self._sequence += 1
+
+    def _on_imu(self, msg):
+        stamp = conv.time_ns(msg.header.stamp)
+        if self._newest is not None and stamp < self._newest:
+            self.counts['restarts'] += 1
+            self.get_logger().info('the gyro stamps went back (a reset): the estimate restarts')
+            self._restart()
+            self._pending = [p for p in self._pending if p[0] >= stamp]
+            heapq.heapify(self._pending)
+        self._newest = stamp
+        w = msg.angular_velocity
+        heapq.heappush(self._pending, (stamp, _GYRO, self._sequence, 'gyro', (w.x, w.y, w.z)))
+        self._sequence += 1
+        self._process(before=stamp)
+
+    def _process(self, before):
+        """Take every pending message stamped before ``before`` (ns), in stamp order."""
+        moved = False
+        while self._pending and self._pending[0][0] < before:
+            stamp, _, _, kind, data = heapq.heappop(self._pending)
+            if kind == 'gyro':
+                moved = self._propagate(stamp, np.array(data)) or moved
+            else:
+                moved = self._update(stamp, kind, data) or moved
+        if moved and self.filter.started:
+            self._publish()
+
+    def _propagate(self, stamp, omega):
+        """Propagate to a gyro sample's stamp with the previous sample's rate (held)."""
+        last, self._gyro = self._gyro, (stamp, omega)
+        self.counts['gyro'] += 1
+        if not self.filter.started:
+            return False
+        held = omega if last is None else last[1]
+        self.filter.propagate(held, (stamp - self._time) * 1e-9)
+        self._time = stamp
+        return True
+
+    def _update(self, stamp, kind, msg):
+        """Correct with one reading at its stamp (after propagating to it); False if not used."""
+        f = self.filter
+        if not f.started:
+            if kind != 'star_tracker':
+                return False
+            o = msg.pose.pose.orientation
+            v = self._values
+            f.start((o.x, o.y, o.z, o.w), self._values['tracker_covariance'],
+                    bias_sigma=self._bias_sigma)
+            self._time = stamp
+            self.counts[kind] += 1
+            self.get_logger().info(f'started at {stamp * 1e-9:.3f} s from the star tracker; '
+                                   f'bias 1 sigma {self._bias_sigma:g} rad/s, magnetometer '
+                                   f'noise {v["magnetometer_noise"]:g} T')
+            return True
+        if stamp < self._time:
+            self.counts['late'] += 1
+            return False
+        if stamp > self._time and self._gyro is not None:   # between two gyro samples
+            f.propagate(self._gyro[1], (stamp - self._time) * 1e-9)
+            self._time = stamp
+        if not self._correct(stamp, kind, msg):
+            return False
+        self.counts[kind] += 1
+        return True
+
+    def _correct(self, stamp, kind, msg):
+        """Apply a reading of ``kind``; False when the model it needs is not configured."""
+        f, v, t = self.filter, self._values, stamp * 1e-9
+        if kind == 'star_tracker':
+            o = msg.pose.pose.orientation
+            f.update_attitude((o.x, o.y, o.z, o.w), v['tracker_covariance'])
+        elif kind == 'sun_sensor':
+            if v['sun'] is None or not v['sun_sensor_noise']:
+                return False
+            s = msg.vector
+            f.update_vector((s.x, s.y, s.z), v['sun'].direction(t), v['sun_sensor_noise'] ** 2)
+        else:
+            if v['field'] is None or not v['magnetometer_noise']:
+                return False
+            b = msg.magnetic_field
+            world = v['field'].world(t, v['orbit'].position(t))
+            size = math.sqrt(sum(c * c for c in world))
+            # the reading's noise as an angle: sigma / norm(B)
+            f.update_vector((b.x, b.y, b.z), world, (v['magnetometer_noise'] / size) ** 2)
+        return True
+
+    # ---------------------------------------------------------------- output
+    def _publish(self):
+        f, msg = self.filter, self._estimate
+        msg.header.stamp = conv.time_msg(self._time)
+        msg.pose.pose.orientation = conv.quaternion_msg(f.q)
+        cov = np.zeros((6, 6))
+        cov[:3, :3] = np.eye(3) * UNMEASURED
+        cov[3:, 3:] = f.attitude_covariance_world()
+        msg.pose.covariance = cov.ravel().tolist()
+        self._pub.publish(msg)
+        bias = Vector3Stamped()
+        bias.header.stamp, bias.header.frame_id = msg.header.stamp, self._body
+        bias.vector = conv.vector_msg(f.bias)
+        self._pub_bias.publish(bias)
+
+    def _diagnose(self):
+        f = self.filter
+        if f.started:
+            sigma = np.sqrt(np.diag(f.P))
+            level, message = DiagnosticStatus.OK, (
+                f'estimating: attitude 1 sigma {float(np.linalg.norm(sigma[:3])):.3g} rad')
+            values = [('attitude sigma (rad, body axes)', sigma[:3].tolist()),
+                      ('bias sigma (rad/s)', sigma[3:].tolist()),
+                      ('bias estimate (rad/s)', f.bias.tolist())]
+        else:
+            level, message = DiagnosticStatus.OK, 'waiting for the first star_tracker reading'
+            values = []
+        values += [(f'{kind} messages used' if kind not in ('late', 'restarts') else
+                    {'late': 'late readings dropped', 'restarts': 'restarts'}[kind], n)
+                   for kind, n in self.counts.items()]
+        array = DiagnosticArray(status=[conv.status(
+            f'{self.get_name()}: filter', level, message, values,
+            self.get_fully_qualified_name())])
+        array.header.stamp = self.get_clock().now().to_msg()
+        self._pub_diag.publish(array)
+
+
+def main(args=None, early=None):
+    """Run until Ctrl-C / SIGTERM; exit 0, or 1 on bad configuration (see runner.run)."""
+    return run(AttitudeEstimator, NODE_NAME, args, early=early)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

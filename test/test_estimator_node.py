@@ -1,0 +1,66 @@
+"""
+Test an estimator against the truth over real topics: the example MEKF judged by the analyzer.
+
+One simulator (gyro and star tracker of doc/examples/estimator.yaml, the tracker
+blinded by the Sun three times), the example estimator told the sensors' noise and
+one told a 10x too small star-tracker noise, and an analyzer for each, all separate
+processes from one parameters file: over 600 s simulated the first is "consistent",
+the detuned one "overconfident", and during the Sun exclusions the estimate coasts
+on the gyro with a growing covariance.
+"""
+
+from pathlib import Path
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import PoseWithCovarianceStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+from rigid_body_dynamics.ros.conversions import time_ns
+
+PARAMS = str(Path(__file__).resolve().parents[1] / 'doc' / 'examples' / 'estimator.yaml')
+#: The body's z axis (the tracker's boresight) at 440 s: the Sun there blinds the tracker
+#: (20 deg exclusion cone) from about 425 to 455 s, and from 145 to 175 s.
+SUN = [0.5513401425753413, -0.016122503862582294, -0.8341247580873039]
+SECONDS = 600
+
+
+def _verdict(probe, name):
+    found = probe.newest_status(f'{name}: estimation')
+    return found and found[2].get('verdict')
+
+
+def test_the_example_mekf_is_consistent_and_a_detuned_one_overconfident(launch, probe):
+    launch('rigid_body_dynamics.nodes.simulator', '--params-file', PARAMS,
+           '-p', f'sun_direction:={SUN}', '-p', 'star_tracker_sun_exclusion:=0.35', name='sim')
+    launch('rigid_body_dynamics.nodes.estimator', '--params-file', PARAMS, name='estimator')
+    launch('rigid_body_dynamics.nodes.estimator', '--params-file', PARAMS,
+           '-r', '__node:=detuned_estimator', '-r', 'attitude_estimate:=detuned/attitude_estimate',
+           '-p', 'star_tracker_noise:=[2.0e-6, 2.0e-6, 1.5e-5]', name='detuned')
+    launch('rigid_body_dynamics.nodes.analyzer', '--params-file', PARAMS, name='analyzer')
+    launch('rigid_body_dynamics.nodes.analyzer', '-r', '__node:=detuned_analyzer',
+           '-r', 'attitude_estimate:=detuned/attitude_estimate', '-p', 'window:=600.0',
+           name='detuned_analyzer')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    odom = probe.subscribe(Odometry, 'odom')
+    estimates = probe.subscribe(PoseWithCovarianceStamped, 'attitude_estimate')
+    probe.spin_until(lambda: odom and time_ns(odom[-1].header.stamp) >= SECONDS * 10 ** 9,
+                     240.0, f'{SECONDS} s simulated')
+    seen = len(probe.messages['/diagnostics'])
+    probe.spin_until(lambda: sum(1 for a in probe.messages['/diagnostics'][seen:]
+                                 for s in a.status if s.name.endswith(': estimation')) >= 4,
+                     30.0, 'both estimation statuses after the run')
+    level, message, values = probe.newest_status('attitude_analyzer: estimation')
+    assert values['verdict'] == 'consistent' and level == DiagnosticStatus.OK, message
+    assert message.startswith('consistent: mean NEES')
+    assert int(values['estimates matched']) > 0.9 * SECONDS * 20
+    assert float(values['fraction inside 3 sigma']) > 0.99
+    level, message, values = probe.newest_status('detuned_analyzer: estimation')
+    assert values['verdict'] == 'overconfident' and level == DiagnosticStatus.WARN, message
+    assert float(values['mean NEES']) > 30.0
+    # the Sun exclusions: fewer readings than ticks, and the estimate coasts on the gyro
+    _, _, counts = probe.newest_status('sensors')
+    assert int(counts['star_tracker excluded (sun)']) > 2 * 25 * 5, counts
+    sigma = {time_ns(m.header.stamp) // 10 ** 9: np.sqrt(np.trace(
+        np.reshape(m.pose.covariance, (6, 6))[3:, 3:])) for m in estimates}
+    assert sigma[445] > 3.0 * sigma[400], (sigma[400], sigma[445])
+    assert sigma[480] < 1.5 * sigma[400]                 # and recovers once it sees again
