@@ -69,8 +69,9 @@ def test_the_filter_reaches_farrenkopfs_steady_state_and_its_errors_match_it():
     Check the MEKF's steady state against the single-axis theory, over 400 s.
 
     The filter's post-update attitude sigma per axis within 0.5 % of the theory
-    (measured 0.04 %), its bias errors inside 5 sigma of the theory's; the measured post-update errors'
-    sigma within 5 % of it (400 s of readings after 100 s of convergence: 3000 samples).
+    (measured 0.04 %), its bias errors inside 5 sigma of the theory's; the measured
+    post-update errors' sigma within 5 % of it (400 s of readings after 100 s of
+    convergence: 4000 samples).
     """
     q, est, _, cov_body, bias, bias_est = _run(500.0)
     attitude, bias_sigma = _farrenkopf()
@@ -105,7 +106,7 @@ def test_a_filter_told_too_much_noise_is_pessimistic():
 
 
 def test_vector_updates_alone_converge_consistently():
-    """Two known directions (a sun sensor's and a magnetometer's) fix the attitude, consistently."""
+    """Fix the attitude from two known directions (a sun sensor's, a magnetometer's)."""
     t = np.arange(0, 20001) / RATE
     q, w = FreeRigidBody((2.0, 3.0, 1.2), (0.02, -0.01, 0.015), (0, 0, 0, 1)).state_at(t)
     measured, _ = GyroModel(GyroErrors(N, K), RATE, seed=3).sample(w)

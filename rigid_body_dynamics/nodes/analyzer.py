@@ -27,7 +27,8 @@ import math
 import sys
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from geometry_msgs.msg import InertiaStamped, PoseWithCovarianceStamped, WrenchStamped
+from geometry_msgs.msg import InertiaStamped, PoseWithCovarianceStamped, Vector3Stamped
+from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.clock import Clock, ClockType
@@ -64,6 +65,12 @@ INPUT_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
 LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                          reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+#: The gyro's true bias and its estimate: the simulator's ~/imu_bias and the example
+#: estimator's ~/gyro_bias_estimate, as seen from a node in the same namespace (remap them
+#: for other nodes).
+BIAS_TOPICS = {'true': 'attitude_simulator/imu_bias',
+               'estimate': 'attitude_estimator/gyro_bias_estimate'}
 
 #: Stamps (ns) before and after any real one: the baseline floor's "no limit" and "not yet".
 _ALWAYS, _NEVER = -2 ** 63, 2 ** 63 - 1
@@ -161,6 +168,7 @@ class SampleBuffer:
         self.wheel_t, self.wheel = [], []
         self.orbit_t, self.orbit = [], []
         self.estimate_t, self.estimate = [], []
+        self.bias = {'true': {}, 'estimate': {}}      # stamp (ns) -> bias (rad/s, body)
 
     def add(self, t, q, w, reset_jump, max_gap):
         """Insert one state sample (stamp t, ns) in stamp order; duplicates are dropped."""
@@ -195,13 +203,27 @@ class SampleBuffer:
         """Insert one attitude estimate (stamp t, ns): q and its covariance (3 x 3, rad^2)."""
         _insert(self.estimate_t, self.estimate, t, (q, covariance))
 
+    def add_bias(self, kind, t, bias):
+        """Keep one gyro bias (rad/s, body) stamped t (ns): ``kind`` 'true' or 'estimate'."""
+        self.bias[kind][t] = tuple(bias)
+
     def estimate_arrays(self):
-        """Return (true q, estimated q, covariances) at the stamps both have (may be empty)."""
+        """
+        Return (true q, estimated q, covariances, true bias, bias estimate) at common stamps.
+
+        The attitudes at the stamps both odom and the estimate have; the biases (N, 3)
+        where every one of those stamps has both, else None.
+        """
         index = {t: i for i, t in enumerate(self.t)}
-        rows = [(index[t], e) for t, e in zip(self.estimate_t, self.estimate) if t in index]
-        return (np.array([self.q[i] for i, _ in rows]).reshape(-1, 4),
-                np.array([e[0] for _, e in rows]).reshape(-1, 4),
-                np.array([e[1] for _, e in rows]).reshape(-1, 3, 3))
+        rows = [(t, index[t], e) for t, e in zip(self.estimate_t, self.estimate) if t in index]
+        true, estimate = self.bias['true'], self.bias['estimate']
+        biases = None, None
+        if rows and all(t in true and t in estimate for t, _, _ in rows):
+            biases = (np.array([true[t] for t, _, _ in rows]),
+                      np.array([estimate[t] for t, _, _ in rows]))
+        return (np.array([self.q[i] for _, i, _ in rows]).reshape(-1, 4),
+                np.array([e[0] for _, _, e in rows]).reshape(-1, 4),
+                np.array([e[1] for _, _, e in rows]).reshape(-1, 3, 3)) + biases
 
     def orbit_arrays(self):
         """Return (position, velocity) (N, 3) at the state stamps, or None unless all have one."""
@@ -242,6 +264,8 @@ class SampleBuffer:
         del self.orbit_t[:j], self.orbit[:j]
         j = bisect.bisect_left(self.estimate_t, keep_from)
         del self.estimate_t[:j], self.estimate[:j]
+        for kind, found in self.bias.items():
+            self.bias[kind] = {t: b for t, b in found.items() if t >= keep_from}
 
     def arrays(self):
         """(t ns int64, q, omega, torque at the state stamps); torque 0 where none is known."""
@@ -284,6 +308,9 @@ class AttitudeAnalyzer(Node):
         self._intake.subscribe(WrenchStamped, 'applied_torque', INPUT_QOS)
         self._intake.subscribe(JointState, 'wheel_state', INPUT_QOS)
         self._intake.subscribe(PoseWithCovarianceStamped, 'attitude_estimate', INPUT_QOS)
+        # the gyro's true bias and an estimate of it, under the default nodes' private names
+        self._intake.subscribe(Vector3Stamped, BIAS_TOPICS['true'], INPUT_QOS)
+        self._intake.subscribe(Vector3Stamped, BIAS_TOPICS['estimate'], INPUT_QOS)
         self._estimates = 0
         self.create_subscription(InertiaStamped, 'inertia', self._on_inertia, LATCHED_QOS)
         self._pub = {name: self.create_publisher(Float64, name, 10) for name in (
@@ -378,6 +405,13 @@ class AttitudeAnalyzer(Node):
             for stamp, q, cov in zip(*samples.pose_covariance_batch(raws, decode)):
                 if np.all(np.isfinite(q)) and np.all(np.isfinite(cov)):
                     self._buffer.add_estimate(int(stamp), q, cov)
+        for kind, topic in BIAS_TOPICS.items():
+            for raw in self._intake.take(topic):
+                msg = deserialize_message(raw, Vector3Stamped)
+                v = msg.vector
+                if all(math.isfinite(c) for c in (v.x, v.y, v.z)):
+                    self._buffer.add_bias(kind, samples.stamp_ns(msg.header.stamp),
+                                          (v.x, v.y, v.z))
         for raw in self._intake.take('wheel_state'):
             msg = deserialize_message(raw, JointState)
             self._buffer.add_wheels(samples.stamp_ns(msg.header.stamp), msg.velocity,

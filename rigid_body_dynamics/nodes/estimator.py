@@ -1,5 +1,5 @@
 """
-attitude_estimator: an example attitude estimator (a multiplicative EKF) for the simulator's sensors.
+attitude_estimator: an example attitude estimator (a multiplicative EKF) for the sensors.
 
 It fuses the gyro (``imu``'s angular velocity) with the ``star_tracker`` and,
 where they publish, the ``sun_sensor`` and the magnetometer (``magnetic_field``)

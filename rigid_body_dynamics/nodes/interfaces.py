@@ -188,6 +188,13 @@ ANALYZER = Interfaces('attitude_analyzer', [
               "Any estimator's attitude and its covariance (about the world's axes), judged "
               'against odom at the same stamps: the `estimation` status (hidden helper node '
               '`_attitude_analyzer_intake`).'),
+    Interface('sub', 'attitude_simulator/imu_bias', 'geometry_msgs/msg/Vector3Stamped',
+              "The simulator's true gyro bias (its ~/imu_bias in this namespace): with "
+              'attitude_estimator/gyro_bias_estimate, the bias error in `estimation`.'),
+    Interface('sub', 'attitude_estimator/gyro_bias_estimate',
+              'geometry_msgs/msg/Vector3Stamped',
+              "The example estimator's ~/gyro_bias_estimate (remap it for another "
+              'estimator).'),
     Interface('pub', 'precession/body_rate', 'std_msgs/msg/Float64',
               "rad/s: omega about the symmetry axis, body frame (the seed's Omega)."),
     Interface('pub', 'precession/lab_rate', 'std_msgs/msg/Float64',

@@ -102,6 +102,8 @@ OTHER_KEYS = (
     ('correlation time (samples)', 'the integrated autocorrelation time of the whitened '
      'errors'),
     ('independent samples', 'estimates matched / correlation time: what the interval counts'),
+    ('gyro bias error RMS per body axis (rad/s)', 'the bias estimate against the true bias, '
+     "when both are published at the estimates' stamps"),
 ))
 #: What each quantity is, for the manual.
 MEANINGS = {
@@ -298,6 +300,9 @@ def estimation_key_values(e):
                    ('NEES 95 % interval', list(e.bounds)),
                    ('correlation time (samples)', e.correlation),
                    ('independent samples', e.independent)]
+        if e.bias_rms is not None:
+            values.append(('gyro bias error RMS per body axis (rad/s)',
+                           [float(c) for c in e.bias_rms]))
     return e.status, e.message, values
 
 
