@@ -13,6 +13,7 @@ import importlib.metadata
 import os
 import shutil
 import sys
+from xml.etree import ElementTree
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 sys.path.insert(0, ROOT)
@@ -20,7 +21,8 @@ sys.path.insert(0, ROOT)
 project = 'rigid_body_dynamics'
 author = 'rigid_body_dynamics maintainers'
 copyright = '2026, rigid_body_dynamics maintainers'  # noqa: A001 (Sphinx's name)
-release = version = '0.2.0'
+# the version is package.xml's, as colcon and rosdoc2 read it
+release = version = ElementTree.parse(os.path.join(ROOT, 'package.xml')).findtext('version')
 
 extensions = [
     'myst_parser',

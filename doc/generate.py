@@ -44,8 +44,11 @@ def analyzer_keys_page():
 
     def cell(text):
         return text.replace('|', '\\|')
+    from rigid_body_dynamics.nodes.analyzer import INPUT_KEYS
     lines += [f'| `{sec}` | `{cell(key)}` | {cell(meaning)} |'
               for sec, key, meaning in reference_rows()]
+    lines += [f'| `input` | `{cell(key)}` | {cell(meaning)} |'
+              for key, meaning in INPUT_KEYS.items()]
     return '\n'.join(lines + [''])
 
 

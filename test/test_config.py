@@ -15,6 +15,7 @@ import pytest
 import rclpy
 from rclpy.context import Context
 from rigid_body_dynamics.nodes.analyzer import AttitudeAnalyzer
+from rigid_body_dynamics.nodes.estimator import AttitudeEstimator
 from rigid_body_dynamics.nodes.poinsot import PoinsotVisualizer
 from rigid_body_dynamics.nodes.simulator import AttitudeSimulator
 from rigid_body_dynamics.physics import presets
@@ -105,11 +106,12 @@ def test_launch_file_sets_only_declared_parameters_of_installed_executables():
     assert ('rviz2', 'rviz2', set()) in nodes     # rviz:=true; its config: test_rviz_config
     nodes = [n for n in nodes if n[1] != 'rviz2']
     assert {n[0] for n in nodes} == {'attitude_simulator', 'attitude_analyzer',
-                                     'poinsot_visualizer'}
+                                     'poinsot_visualizer', 'attitude_estimator'}
     setup = open(os.path.join(ROOT, 'setup.py')).read()
     declared = {'attitude_simulator': _declared(AttitudeSimulator),
                 'attitude_analyzer': _declared(AttitudeAnalyzer),
-                'poinsot_visualizer': _declared(PoinsotVisualizer)}
+                'poinsot_visualizer': _declared(PoinsotVisualizer),
+                'attitude_estimator': _declared(AttitudeEstimator)}
     for executable, package, keys in nodes:
         assert package == 'rigid_body_dynamics'
         assert f"'{executable} = rigid_body_dynamics.nodes." in setup

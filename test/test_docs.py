@@ -47,6 +47,14 @@ def test_the_generated_reference_is_current():
     assert run.returncode == 0, run.stderr
 
 
+def test_every_key_of_the_analyzer_s_input_status_is_documented():
+    """The keys _input_status writes (read from its source) are the documented INPUT_KEYS."""
+    import inspect
+    source = inspect.getsource(analyzer.AttitudeAnalyzer._input_status)
+    written = set(re.findall(r"\('([^']+)', ", source))
+    assert written == set(analyzer.INPUT_KEYS), written ^ set(analyzer.INPUT_KEYS)
+
+
 class _Page(HTMLParser):
     """The links, resources and element ids of one HTML page."""
 

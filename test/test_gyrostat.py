@@ -148,9 +148,9 @@ def test_friction_spins_a_wheel_down_as_its_closed_form():
 
 
 @pytest.mark.parametrize('kwargs,match', [
-    ({'axes': (1.0, 0.0), 'inertia': ()}, '3 numbers per wheel'),
-    ({'axes': ((0.0, 0.0, 0.0),), 'inertia': (0.1,)}, 'non-zero'),
-    ({'axes': ((1.0, 1.0, 0.0),), 'inertia': (0.1,)}, 'unit vector'),
+    ({'axes': (1.0, 0.0), 'inertia': ()}, 'wheel_axes needs 3 numbers per wheel'),
+    ({'axes': ((0.0, 0.0, 0.0),), 'inertia': (0.1,)}, 'wheel_axes: axis 0 must be .*non-zero'),
+    ({'axes': ((1.0, 1.0, 0.0),), 'inertia': (0.1,)}, 'wheel_axes: axis 0 must be a unit'),
     ({'axes': ((1.0, 0.0, 0.0),), 'inertia': (0.1, 0.2)}, 'needs 1 values'),
     ({'axes': ((1.0, 0.0, 0.0),), 'inertia': (0.0,)}, 'wheel_inertia.0. must be .* > 0'),
     ({'axes': ((1.0, 0.0, 0.0),), 'inertia': (0.1,), 'max_speed': (-1.0,)},

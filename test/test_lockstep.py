@@ -197,3 +197,25 @@ def test_bad_closed_loop_parameters_are_refused_with_the_reason(launch, args, re
     proc = launch('rigid_body_dynamics.nodes.simulator', *args, name='bad_closed_loop')
     assert proc.wait(30.0) == 1
     assert reason in proc.output()
+
+
+def test_the_controller_takes_best_effort_odometry_when_told(launch, probe):
+    """
+    A best-effort odom source does not reach the controller's reliable subscription; with
+    qos_overrides./odom.subscription.reliability best_effort it does, and is answered.
+    """
+    from geometry_msgs.msg import InertiaStamped, WrenchStamped
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from ros_harness import LATCHED, odom_msg
+    best_effort = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
+    launch('rigid_body_dynamics.nodes.controller', '-p', 'control_rate:=0.0',
+           '-p', 'qos_overrides./odom.subscription.reliability:=best_effort', name='ctl')
+    answers = probe.subscribe(WrenchStamped, 'torque_cmd')
+    inertia = probe.node.create_publisher(InertiaStamped, 'inertia', LATCHED)
+    msg = InertiaStamped()
+    msg.inertia.ixx, msg.inertia.iyy, msg.inertia.izz = 1.0, 2.0, 3.0
+    inertia.publish(msg)
+    odom = probe.publisher(Odometry, 'odom', qos=best_effort)
+    probe.handshake(odom, odom_msg(0.01, (0.0, 0.0, 0.0, 1.0), (0.1, 0.0, 0.0)),
+                    lambda: bool(answers))
+    assert answers[0].wrench.torque.x < 0.0          # the target is rest: it brakes omega_x

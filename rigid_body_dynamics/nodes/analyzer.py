@@ -72,6 +72,26 @@ LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
 BIAS_TOPICS = {'true': 'attitude_simulator/imu_bias',
                'estimate': 'attitude_estimator/gyro_bias_estimate'}
 
+#: The keys of the ``input`` status and what they mean (the manual's table is made from this).
+INPUT_KEYS = {
+    'messages received': 'odom messages taken since the start',
+    'rate (Hz)': 'odom messages per second of wall time over the last few periods',
+    'restarts after a time reset': 'stamps that jumped back by more than `reset_jump` (a '
+                                   'simulator reset): the estimates restarted',
+    'restarts after a gap': 'gaps between stamps longer than `max_gap`: the estimates '
+                            'restarted',
+    'dropped non-finite samples': 'odom samples with a non-finite or zero quaternion or rate',
+    'dropped samples in another frame': 'odom samples whose twist is neither in the body frame '
+                                        'nor in the world frame',
+    'inertia source': '`parameter`, `topic` or `none`',
+    'body frame': "the inertia's frame id (`any` until it is known)",
+    'samples in the window': 'odom samples the analysis uses',
+    'window first stamp (ns)': 'the oldest of them',
+    'window last stamp (ns)': 'the newest of them',
+    'age of the last message (s)': 'wall time since an odom last arrived; above '
+                                   '`stale_timeout` the status is STALE',
+}
+
 #: Stamps (ns) before and after any real one: the baseline floor's "no limit" and "not yet".
 _ALWAYS, _NEVER = -2 ** 63, 2 ** 63 - 1
 

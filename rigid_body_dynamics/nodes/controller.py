@@ -155,7 +155,9 @@ class AttitudeController(Node):
         self.create_subscription(QuaternionStamped, 'target_orientation', self._on_target,
                                  STATE_QOS)
         self._intake = Intake(self)
-        self._intake.subscribe(Odometry, 'odom', STATE_QOS)
+        # reliable by default (lockstep answers every state); a best-effort odometry source
+        # needs qos_overrides./odom.subscription.reliability: best_effort
+        self._intake.subscribe(Odometry, 'odom', STATE_QOS, overridable=True)
         if self._bdot:
             self._intake.subscribe(MagneticField, 'magnetic_field', STATE_QOS)
         if self._allocator is not None:

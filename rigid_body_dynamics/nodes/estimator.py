@@ -33,6 +33,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseWithCovarianceStamped, Vector3Stamped
 import numpy as np
 from rclpy.node import Node
+from rclpy.qos_overriding_options import QoSOverridingOptions
 from sensor_msgs.msg import Imu, MagneticField
 
 from .environment_parameters import environment_params, orbit_from
@@ -115,13 +116,14 @@ class AttitudeEstimator(Node):
         self._pub_bias = self.create_publisher(Vector3Stamped, '~/gyro_bias_estimate',
                                                STATE_QOS)
         self._pub_diag = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-        self.create_subscription(Imu, 'imu', self._on_imu, STATE_QOS)
-        self.create_subscription(PoseWithCovarianceStamped, 'star_tracker',
-                                 lambda m: self._queue(m, 'star_tracker'), STATE_QOS)
-        self.create_subscription(Vector3Stamped, 'sun_sensor',
-                                 lambda m: self._queue(m, 'sun_sensor'), STATE_QOS)
-        self.create_subscription(MagneticField, 'magnetic_field',
-                                 lambda m: self._queue(m, 'magnetometer'), STATE_QOS)
+        # reliable (as the simulator publishes), or as qos_overrides.<topic>.subscription say
+        qos = {'qos_overriding_options': QoSOverridingOptions.with_default_policies()}
+        self.create_subscription(Imu, 'imu', self._on_imu, STATE_QOS, **qos)
+        for msg_type, topic, kind in ((PoseWithCovarianceStamped, 'star_tracker', 'star_tracker'),
+                                      (Vector3Stamped, 'sun_sensor', 'sun_sensor'),
+                                      (MagneticField, 'magnetic_field', 'magnetometer')):
+            self.create_subscription(msg_type, topic, lambda m, kind=kind: self._queue(m, kind),
+                                     STATE_QOS, **qos)
         self.create_timer(1.0, self._diagnose)
         estimate = PoseWithCovarianceStamped()
         estimate.header.frame_id = self._world

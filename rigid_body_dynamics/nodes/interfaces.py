@@ -219,7 +219,8 @@ POINSOT = Interfaces('poinsot_visualizer', [
 
 CONTROLLER = Interfaces('attitude_controller', [
     Interface('sub', 'odom', 'nav_msgs/msg/Odometry',
-              'The states to answer (taken by its own thread; hidden helper node '
+              'The states to answer; reliable, depth 10, `qos_overrides` for a best-effort '
+              'source (taken by its own thread; hidden helper node '
               '`_attitude_controller_intake`).'),
     Interface('sub', 'inertia', 'geometry_msgs/msg/InertiaStamped',
               'Latched; no command before it (its diagonal gives the gains).'),

@@ -89,7 +89,7 @@ class Wheels:
         flat = [float(c) for axis in self.axes for c in (axis if hasattr(axis, '__len__')
                                                          else (axis,))]
         if len(flat) % 3:
-            raise ValueError(f'wheel axes need 3 numbers per wheel, got {len(flat)}')
+            raise ValueError(f'wheel_axes needs 3 numbers per wheel, got {len(flat)}')
         n = len(flat) // 3
         if n > MAX_WHEELS:
             raise ValueError(f'at most {MAX_WHEELS} wheels, got {n}')
@@ -98,10 +98,10 @@ class Wheels:
             g = flat[3 * i:3 * i + 3]
             norm = math.sqrt(sum(c * c for c in g))
             if not math.isfinite(norm) or norm == 0.0:
-                raise ValueError(f'wheel axis {i} must be a finite non-zero vector, got {g}')
+                raise ValueError(f'wheel_axes: axis {i} must be a finite non-zero vector, got {g}')
             if abs(norm - 1.0) > AXIS_TOLERANCE:
-                raise ValueError(f'wheel axis {i} must be a unit vector (normalised), got {g} '
-                                 f'of length {norm:.9g}')
+                raise ValueError(f'wheel_axes: axis {i} must be a unit vector (normalised), got '
+                                 f'{g} of length {norm:.9g}')
             axes.append(tuple(c / norm for c in g))
         set_ = object.__setattr__
         set_(self, 'axes', tuple(axes))
