@@ -114,13 +114,15 @@ def test_an_overloaded_fleet_of_128_bodies_exits_within_5_s_of_sigint(launch, pr
 
 def test_a_fleet_body_in_orbit_beside_a_free_one(launch, probe, tmp_path):
     """
-    Check that the orbit, its torques and the magnetometer are per body in a fleet.
+    Check that the orbit, its torques and the sensors are per body in a fleet.
 
-    body1 in a 500 km orbit with the gravity gradient, the field and a magnetometer at
-    10 Hz; body2 free: body1's odom position is Kepler's at its stamps (1e-12 relative),
-    body2's is 0 and it has no magnetic_field topic.
+    body1 in a 500 km orbit with the gravity gradient, the field, a magnetometer and a
+    noiseless star tracker at 10 Hz; body2 free: body1's odom position is Kepler's at its
+    stamps (1e-12 relative), its star tracker reads odom's attitude (1e-15), body2's
+    position is 0 and it has no magnetic_field or star_tracker topic.
     """
     from rigid_body_dynamics.physics.environment import KeplerOrbit
+    from geometry_msgs.msg import PoseWithCovarianceStamped
     from sensor_msgs.msg import MagneticField
     elements = [6878137.0, 0.001, 1.2, 0.3, 0.0, 0.5]
     params = tmp_path / 'fleet.yaml'
@@ -131,14 +133,18 @@ def test_a_fleet_body_in_orbit_beside_a_free_one(launch, probe, tmp_path):
     gravity_gradient: true
     magnetic_field_model: dipole
     magnetometer_rate: 10.0
+    star_tracker_rate: 10.0
+    star_tracker_noise: [0.0, 0.0, 0.0]
 """)
     launch(FLEET, '--params-file', str(params), '--', '--bodies', '2', name='fleet')
     odom = {k: probe.subscribe(Odometry, f'/body{k}/odom') for k in (1, 2)}
     inertia = probe.subscribe(InertiaStamped, '/body1/inertia', LATCHED)
     field = probe.subscribe(MagneticField, '/body1/magnetic_field')
+    stars = probe.subscribe(PoseWithCovarianceStamped, '/body1/star_tracker')
     for k in (1, 2):
         probe.wait_for(f'/body{k}/odom', 20, timeout=30.0)
     probe.wait_for('/body1/magnetic_field', 5)
+    probe.wait_for('/body1/star_tracker', 3)
     probe.wait_for('/body1/inertia', 1)
     start = time_ns(inertia[0].header.stamp)
     orbit = KeplerOrbit(elements)
@@ -151,3 +157,12 @@ def test_a_fleet_body_in_orbit_beside_a_free_one(launch, probe, tmp_path):
                                   field[-1].magnetic_field.z]) < 6e-5
     assert not probe.endpoints('pub', 'attitude_simulator', '/body2').get(
         '/body2/magnetic_field')
+    assert not probe.endpoints('pub', 'attitude_simulator', '/body2').get(
+        '/body2/star_tracker')
+    by_stamp = {time_ns(m.header.stamp): m.pose.pose.orientation for m in odom[1]}
+    matched = [(m.pose.pose.orientation, by_stamp[time_ns(m.header.stamp)]) for m in stars
+               if time_ns(m.header.stamp) in by_stamp]
+    assert matched, 'no star tracker reading at an odom stamp'
+    for got, true in matched:
+        assert max(abs(got.x - true.x), abs(got.y - true.y), abs(got.z - true.z),
+                   abs(got.w - true.w)) < 1e-15

@@ -201,7 +201,9 @@ def test_bad_closed_loop_parameters_are_refused_with_the_reason(launch, args, re
 
 def test_the_controller_takes_best_effort_odometry_when_told(launch, probe):
     """
-    A best-effort odom source does not reach the controller's reliable subscription; with
+    Answer a best-effort odom source once told so by qos_overrides.
+
+    It does not reach the controller's reliable subscription by default; with
     qos_overrides./odom.subscription.reliability best_effort it does, and is answered.
     """
     from geometry_msgs.msg import InertiaStamped, WrenchStamped

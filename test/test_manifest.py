@@ -144,6 +144,6 @@ def test_a_tool_without_an_optional_module_says_what_to_install(tmp_path, tool, 
 def test_setup_py_and_the_manual_have_package_xml_s_version():
     version = ElementTree.parse(os.path.join(ROOT, 'package.xml')).findtext('version')
     assert f"version='{version}'" in open(os.path.join(ROOT, 'setup.py')).read()
-    assert 'findtext(\'version\')' in open(os.path.join(ROOT, 'doc', 'conf.py')).read()
+    assert "findtext('version')" in open(os.path.join(ROOT, 'doc', 'conf.py')).read()
     assert f'{version} (unreleased)' in open(os.path.join(ROOT, 'CHANGELOG.rst')).read() or \
         f'\n{version}\n' in open(os.path.join(ROOT, 'CHANGELOG.rst')).read()
