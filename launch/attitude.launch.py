@@ -19,7 +19,7 @@ every node but the simulator runs on its /clock (``use_sim_time``).
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
 from launch.conditions import IfCondition
-from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
+from launch.substitutions import LaunchConfiguration, PathJoinSubstitution, PythonExpression
 from launch_ros.actions import Node
 from launch_ros.substitutions import FindPackageShare
 
@@ -42,6 +42,11 @@ def generate_launch_description():
                               description='also start the example attitude_estimator'),
         DeclareLaunchArgument('namespace', default_value='',
                               description='namespace for both nodes (one body per namespace)'),
+        DeclareLaunchArgument('frame_prefix',
+                              default_value=PythonExpression(
+                                  ["'", namespace, "/' if '", namespace, "' else ''"]),
+                              description="prefix of the simulator's frame ids (default: "
+                                          '<namespace>/, so bodies give distinct TF trees)'),
         DeclareLaunchArgument('real_time_factor', default_value='1.0',
                               description='simulated seconds per wall second; 0 = as fast '
                                           'as possible'),
@@ -59,6 +64,7 @@ def generate_launch_description():
                  'real_time_factor': LaunchConfiguration('real_time_factor'),
                  'integrator': LaunchConfiguration('integrator'),
                  'publish_clock': LaunchConfiguration('publish_clock'),
+                 'frame_prefix': LaunchConfiguration('frame_prefix'),
              }]),
         Node(package='rigid_body_dynamics', executable='attitude_analyzer',
              name='attitude_analyzer', namespace=namespace, output='screen',

@@ -153,6 +153,9 @@ def test_a_fleet_body_in_orbit_beside_a_free_one(launch, probe, tmp_path):
         p = msg.pose.pose.position
         assert np.linalg.norm(np.subtract((p.x, p.y, p.z), r)) < 1e-12 * np.linalg.norm(r)
     assert all(m.pose.pose.position.x == 0.0 for m in odom[2])
+    for k in (1, 2):                                 # frame_prefix <name>/ per fleet body
+        assert {(m.header.frame_id, m.child_frame_id) for m in odom[k]} == {
+            (f'body{k}/odom', f'body{k}/base_link')}
     assert 2e-5 < np.linalg.norm([field[-1].magnetic_field.x, field[-1].magnetic_field.y,
                                   field[-1].magnetic_field.z]) < 6e-5
     assert not probe.endpoints('pub', 'attitude_simulator', '/body2').get(

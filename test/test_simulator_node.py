@@ -456,6 +456,36 @@ def test_tf_is_broadcast_with_the_odom_stamp_and_frames(launch, tf2_msgs_env):
     stop_cleanly(proc)
 
 
+def test_two_namespaced_simulators_give_two_tf_trees(launch, tf2_msgs_env):
+    """
+    Two simulators in /sat1 and /sat2 with frame_prefix sat1/ and sat2/: /tf has both trees.
+
+    Each broadcasts its own sat<k>/odom -> sat<k>/base_link (and no plain odom ->
+    base_link); odom carries the same frame ids.
+    """
+    import json
+    import subprocess
+    import sys
+    for k in (1, 2):
+        launch(SIM, '-r', f'__ns:=/sat{k}', '-p', f'frame_prefix:=sat{k}/',
+               '-p', 'real_time_factor:=2.0', name=f'sim{k}', env=tf2_msgs_env)
+    listener = subprocess.run(
+        [sys.executable, os.path.join(os.path.dirname(__file__), 'tf_listener.py'),
+         '--count', '100', '--odom', '/sat2/odom'], env=dict(os.environ, **tf2_msgs_env),
+        capture_output=True, text=True, timeout=90)
+    assert listener.returncode == 0, listener.stderr[-3000:]
+    got = json.loads(listener.stdout)
+    pairs = {(t[1], t[2]) for m in got['tf'] for t in m}
+    assert pairs == {('sat1/odom', 'sat1/base_link'), ('sat2/odom', 'sat2/base_link')}, pairs
+    assert len(got['publishers']) == 2
+
+
+def test_a_bad_frame_prefix_is_refused_naming_it(launch):
+    proc = launch(SIM, '-p', 'frame_prefix:=/sat1/', name='bad_prefix')
+    assert proc.wait(20.0) == 1
+    assert 'frame_prefix must not start with /' in proc.output(), proc.output()
+
+
 def test_without_tf2_msgs_the_simulator_says_so_and_runs(launch, probe):
     """Where tf2_msgs cannot be imported (pip-only), no /tf publisher and one info line."""
     proc = launch(SIM, '-p', 'real_time_factor:=2.0', name='sim_no_tf')

@@ -21,10 +21,11 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument('--count', type=int, default=50)
     parser.add_argument('--timeout', type=float, default=30.0)
+    parser.add_argument('--odom', default='odom', help='the odometry topic to collect')
     options = parser.parse_args()
     with Probe('tf_listener') as probe:
         tf = probe.subscribe(TFMessage, '/tf', DEEP)
-        odom = probe.subscribe(Odometry, 'odom', DEEP)
+        odom = probe.subscribe(Odometry, options.odom, DEEP)
         probe.spin_until(lambda: len(tf) >= options.count and len(odom) >= options.count,
                          options.timeout, f'{options.count} /tf and odom messages')
         publishers = probe.node.get_publishers_info_by_topic('/tf')

@@ -7,8 +7,10 @@ a parameters file one (``/<name>/attitude_simulator``) or all (``/**/attitude_si
 One interpreter, one executor and one engine Loop thread serve all bodies (benchmarks/
 bodies.py); the bodies are spread over one DDS participant per BODIES_PER_PARTICIPANT
 (Fast DDS tears a participant's entities down in a time that grows with the square of their
-number). One body at most publishes /clock; bodies sharing frames do not broadcast /tf; an
-as-fast-as-possible body makes the others late (run it in its own process).
+number). Each body's frame ids carry its name (``frame_prefix`` ``<name>/``: body1/odom ->
+body1/base_link), so every body broadcasts a TF tree of its own; bodies that still share
+frames (a ``frame_prefix`` given to all) do not broadcast /tf. One body at most publishes
+/clock; an as-fast-as-possible body makes the others late (run it in its own process).
 
 ``attitude_fleet [--bodies N] [--prefix body] [--names a,b,...] [--ros-args ...]``
 """
@@ -66,7 +68,8 @@ class Fleet:
                                signal_handler_options=SignalHandlerOptions.NO)
                     self._contexts.append(context)
                     kwargs['context'] = context
-                self.nodes.append(AttitudeSimulator(namespace='/' + name, **kwargs))
+                self.nodes.append(AttitudeSimulator(frame_prefix_default=name + '/',
+                                                    namespace='/' + name, **kwargs))
             clocks = [n.get_namespace() for n in self.nodes if n.publishes_clock]
             if len(clocks) > 1:
                 raise ConfigurationError(

@@ -113,13 +113,16 @@ class AttitudeSimulator(Node):
     every body's :meth:`member` on one Loop instead.
     """
 
-    def __init__(self, **kwargs):
+    def __init__(self, frame_prefix_default='', **kwargs):
+        # the default of frame_prefix (attitude_fleet gives each body its name)
+        self.frame_prefix_default = frame_prefix_default
         super().__init__(NODE_NAME, **kwargs)
         self._stop = threading.Event()
         self._thread = None
         values = PARAMETERS.validate(PARAMETERS.declare(self))
         self._preset = presets.get(values['preset'])
-        self._frames = (values['world_frame'], values['body_frame'])
+        prefix = values['frame_prefix']
+        self._frames = (prefix + values['world_frame'], prefix + values['body_frame'])
         self._publish_clock = values['publish_clock']
         self.thread_priority = values['thread_priority']
         self._rate = rate = values['integration_rate']
@@ -136,7 +139,7 @@ class AttitudeSimulator(Node):
             wheels=values['wheels'], wheel_speeds=values['wheel_speeds'],
             magnetorquers=values['magnetorquer_max_dipole']
             if values['disturbances'].field is not None else None)
-        self._lvlh_frame = values['lvlh_frame']
+        self._lvlh_frame = prefix + values['lvlh_frame']
         self._publish_rate = values['publish_rate']
         self._decoder = TorqueDecoder(self._frames)
         self._refused_frame = ''

@@ -41,6 +41,15 @@ def _orientation(value):
     return tuple(c / norm for c in q)
 
 
+def _frame_prefix(value):
+    """Check frame_prefix: a string that does not start with '/' (TF frame ids do not)."""
+    text = str(value)
+    if text.startswith('/') or any(c.isspace() for c in text):
+        raise ConfigurationError(f'frame_prefix must not start with / or contain spaces (TF '
+                                 f'frame ids do not), got {text!r}')
+    return text
+
+
 def state_topics(value):
     """Parse state_topics: 'all', 'none' or comma-separated names from OPTIONAL_TOPICS."""
     text = str(value).strip()
@@ -177,6 +186,13 @@ PARAMETERS = ParameterTable([
     Param('body_frame', 'string', 'base_link', '`base_link`',
           'Body frame id of angular_velocity, angular_momentum_body, applied_torque, imu.',
           read_only=True),
+    Param('frame_prefix', 'string', lambda node: getattr(node, 'frame_prefix_default', ''),
+          '"" (attitude_fleet: `<name>/`)',
+          'Prefix of every frame id the node publishes and accepts (world_frame, body_frame, '
+          "lvlh_frame), as robot_state_publisher's frame_prefix: bodies in several namespaces "
+          'then give distinct TF trees, e.g. `sat1/` gives sat1/odom -> sat1/base_link. '
+          'attitude_fleet sets it to `<name>/` for each body unless told otherwise.',
+          read_only=True, convert=_frame_prefix),
     Param('thread_priority', 'int', 0, '0',
           'SCHED_FIFO priority (1-99) of the integration thread on Linux, for fewer missed '
           'deadlines on a loaded machine; 0 = normal scheduling. Needs CAP_SYS_NICE or an '
