@@ -117,3 +117,15 @@ def test_launch_file_sets_only_declared_parameters_of_installed_executables():
         assert f"'{executable} = rigid_body_dynamics.nodes." in setup
         assert keys <= declared[executable], keys - declared[executable]
     assert "'config'" in open(LAUNCH).read()
+
+
+def test_the_manual_lists_every_launch_argument():
+    """The launch-argument table of howto/ros_install.md names exactly what the file declares."""
+    import re
+    tree = ast.parse(open(LAUNCH).read())
+    declared = {call.args[0].value for call in ast.walk(tree) if isinstance(call, ast.Call)
+                and getattr(call.func, 'id', '') == 'DeclareLaunchArgument'}
+    page = open(os.path.join(ROOT, 'doc', 'howto', 'ros_install.md')).read()
+    table = page.split('## The launch file', 1)[1].split('\n## ', 1)[0]
+    listed = set(re.findall(r'^\| `(\w+)` \|', table, re.M))
+    assert listed == declared, listed ^ declared
