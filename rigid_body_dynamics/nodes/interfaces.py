@@ -29,6 +29,12 @@ STANDARD = {
 
 HEADINGS = {'sub': 'Subscribed topics', 'pub': 'Published topics', 'srv': 'Services'}
 
+#: The QoS of a topic, as the node pages write it: reliability, durability, history depth.
+STATE = 'reliable, volatile, 10'
+COMMANDS = 'reliable, volatile, 1000'
+INPUT = 'best effort, volatile, 1000'
+LATCHED = 'reliable, transient local, 1'
+
 
 @dataclass(frozen=True)
 class Interface:
@@ -44,9 +50,15 @@ class Interface:
 class Interfaces:
     """The topics and services of the node ``node`` (its default name)."""
 
-    def __init__(self, node, items):
+    def __init__(self, node, items, qos=None):
         self.node = node
         self.items = tuple(items)
+        #: topic name -> QoS (reliability, durability, depth); the rest are STATE
+        self.qos = dict(qos or {})
+
+    def qos_of(self, item):
+        """Return a topic's QoS text (``reliability, durability, depth``); '' for a service."""
+        return '' if item.kind == 'srv' else self.qos.get(item.name, STATE)
 
     def resolved(self, namespace='/', present=lambda when: True):
         """
@@ -80,10 +92,20 @@ class Interfaces:
             if not items:
                 lines += ['None.', '']
                 continue
-            lines += ['| name | type | meaning | exists |', '| --- | --- | --- | --- |']
+            if kind == 'srv':
+                lines += ['| name | type | meaning | exists |', '| --- | --- | --- | --- |']
+            else:
+                lines += ['| name | type | meaning | QoS | exists |',
+                          '| --- | --- | --- | --- | --- |']
             for i in items:
-                lines.append(f'| `{i.name}` | `{i.type}` | {i.text} | {i.when or "always"} |')
+                qos = '' if kind == 'srv' else f' {self.qos_of(i)} |'
+                lines.append(f'| `{i.name}` | `{i.type}` | {i.text} |{qos} '
+                             f'{i.when or "always"} |')
             lines.append('')
+        lines += ['QoS is reliability, durability and history depth (keep last), as the node '
+                  'creates the endpoint; the test suite compares reliability and durability '
+                  'with the running node. A topic whose node page says so takes '
+                  '`qos_overrides` ({doc}`../../howto/troubleshooting`).', '']
         lines += ['Like every rclpy node it also has `/rosout`, `/parameter_events` and the '
                   'parameter services (`~/list_parameters`, `~/get_parameters`, '
                   '`~/set_parameters`, ...) and `~/get_type_description`.', '']
@@ -169,7 +191,8 @@ SIMULATOR = Interfaces('attitude_simulator', [
               'Back to the initial state; simulated time restarts at 0, the command is cleared.'),
     Interface('srv', '~/pause', 'std_srvs/srv/SetBool',
               '`true` freezes the state (nothing published), `false` resumes.'),
-])
+], qos={'torque_cmd': COMMANDS, 'wheel_cmd': COMMANDS, 'magnetorquer_cmd': COMMANDS,
+     'inertia': LATCHED, '/clock': 'best effort, volatile, 1', '/tf': 'reliable, volatile, 100'})
 
 ANALYZER = Interfaces('attitude_analyzer', [
     Interface('sub', 'odom', 'nav_msgs/msg/Odometry',
@@ -207,7 +230,9 @@ ANALYZER = Interfaces('attitude_analyzer', [
               '`estimation` once an attitude_estimate came).'),
     Interface('srv', '~/reset_baseline', 'std_srvs/srv/Trigger',
               'Measure drift from the next sample on.'),
-])
+], qos={name: INPUT for name in (
+    'odom', 'applied_torque', 'wheel_state', 'attitude_estimate', 'attitude_simulator/imu_bias',
+    'attitude_estimator/gyro_bias_estimate')} | {'inertia': LATCHED})
 
 POINSOT = Interfaces('poinsot_visualizer', [
     Interface('sub', 'odom', 'nav_msgs/msg/Odometry', 'The motion to draw; best effort.'),
@@ -215,7 +240,7 @@ POINSOT = Interfaces('poinsot_visualizer', [
     Interface('pub', 'poinsot_markers', 'visualization_msgs/msg/MarkerArray',
               "In odom's `header.frame_id`: namespace `poinsot` (ellipsoid, omega, normal, "
               'plane, polhode, herpolhode) and `momentum_sphere` (sphere, L, its curve).'),
-])
+], qos={'odom': 'best effort, volatile, 100', 'inertia': LATCHED})
 
 CONTROLLER = Interfaces('attitude_controller', [
     Interface('sub', 'odom', 'nav_msgs/msg/Odometry',
@@ -229,13 +254,19 @@ CONTROLLER = Interfaces('attitude_controller', [
     Interface('sub', 'wheel_state', 'sensor_msgs/msg/JointState',
               'The wheel speeds at the stamp of each state answered (hidden helper node '
               '`_attitude_controller_intake`).', 'if `actuator` is wheels'),
+    Interface('sub', 'magnetic_field', 'sensor_msgs/msg/MagneticField',
+              'The magnetometer readings B-dot answers (hidden helper node '
+              '`_attitude_controller_intake`).', 'if `mode` is bdot'),
+    Interface('pub', 'magnetorquer_cmd', 'geometry_msgs/msg/Vector3Stamped',
+              "The B-dot dipole (A m^2, the reading's frame) stamped with the reading's stamp.",
+              'if `mode` is bdot'),
     Interface('pub', 'torque_cmd', 'geometry_msgs/msg/WrenchStamped',
               'Torque (N m, body frame) stamped with the stamp of the state it answers; with '
               'wheels, the momentum dump (zero unless dumping), published before wheel_cmd.'),
     Interface('pub', 'wheel_cmd', 'std_msgs/msg/Float64MultiArray',
               "Motor torques (N m, one per wheel) flying the law's torque.",
               'if `actuator` is wheels'),
-])
+], qos={'inertia': LATCHED})
 
 ESTIMATOR = Interfaces('attitude_estimator', [
     Interface('sub', 'imu', 'sensor_msgs/msg/Imu',
