@@ -192,7 +192,8 @@ SIMULATOR = Interfaces('attitude_simulator', [
     Interface('srv', '~/pause', 'std_srvs/srv/SetBool',
               '`true` freezes the state (nothing published), `false` resumes.'),
 ], qos={'torque_cmd': COMMANDS, 'wheel_cmd': COMMANDS, 'magnetorquer_cmd': COMMANDS,
-     'inertia': LATCHED, '/clock': 'best effort, volatile, 1', '/tf': 'reliable, volatile, 100'})
+        'inertia': LATCHED, '/clock': 'best effort, volatile, 1',
+        '/tf': 'reliable, volatile, 100'})
 
 ANALYZER = Interfaces('attitude_analyzer', [
     Interface('sub', 'odom', 'nav_msgs/msg/Odometry',
