@@ -101,6 +101,27 @@ def test_every_internal_link_resolves_and_nothing_loads_from_the_network(built):
     assert broken == [] and remote == []
 
 
+def test_the_built_manual_names_no_sessions_issues_or_the_seed(built):
+    """
+    What a user reads: no work sessions, issue numbers, unnamed machines or "the seed".
+
+    (A pytest session and "this machine" for the local host, where DDS stays, are fine.)
+    """
+    import html
+    words = re.compile(r'\b(?:last|this|next|previous|earlier|one) sessions?\b|\bsessions? \d+|'
+                       r'\b(?:two|three) sessions ago\b|\bissue \d+|\bseed text\b|'
+                       r"\bseed's\b|\bthe (?:faster|slower|other) machine\b", re.I)
+    found = {}
+    for page in built.rglob('*.html'):
+        if '_modules' in page.parts or page.name in ('genindex.html', 'search.html'):
+            continue
+        text = html.unescape(re.sub(r'<[^>]+>', ' ', page.read_text()))
+        hits = sorted({m.group(0) for m in words.finditer(text)})
+        if hits:
+            found[str(page.relative_to(built))] = hits
+    assert not found, found
+
+
 def test_pages_open_from_disk_without_errors_and_the_math_is_rendered(built, tmp_path):
     chromium = _chromium()
     dom = {}

@@ -123,7 +123,7 @@ def test_period_and_mean_precession_against_exact_motion(moments, omega0):
 def test_chandler_period_is_about_300_sidereal_days():
     period = theory.chandler_wobble_period()
     assert period / theory.SIDEREAL_DAY == pytest.approx(300.0, rel=1e-12)
-    assert 9.5 < period / (30.4375 * 86400.0) < 10.0       # the seed's "10 months"
+    assert 9.5 < period / (30.4375 * 86400.0) < 10.0       # Shapiro's "10 months"
 
 
 def test_earth_preset_wobble_period_from_simulation():

@@ -48,7 +48,8 @@ def body_names(bodies, prefix, names):
 
 #: Bodies per DDS participant (rclpy Context). Destroying a participant's entities one by one
 #: costs Fast DDS time that grows with the square of their number: 96 bodies (5376 entities)
-#: took 4.1-4.4 s to tear down in one participant, 1.3 s in six (benchmarks/RESULTS.md), so a
+#: took 4.1-4.4 s to tear down in one participant, 1.3 s in six (measured 2026-12-02; RESULTS.md
+#: at commit 345c04f, "The Jazzy stack, start-up and a fleet's exit"), so a
 #: fleet did not exit within the 5 s that ros2 launch waits after SIGINT.
 BODIES_PER_PARTICIPANT = 16
 

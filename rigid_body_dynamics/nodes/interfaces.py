@@ -220,7 +220,7 @@ ANALYZER = Interfaces('attitude_analyzer', [
               "The example estimator's ~/gyro_bias_estimate (remap it for another "
               'estimator).'),
     Interface('pub', 'precession/body_rate', 'std_msgs/msg/Float64',
-              "rad/s: omega about the symmetry axis, body frame (the seed's Omega)."),
+              "rad/s: omega about the symmetry axis, body frame (Shapiro's Omega)."),
     Interface('pub', 'precession/lab_rate', 'std_msgs/msg/Float64',
               'rad/s: the symmetry axis about L, inertial frame.'),
     Interface('pub', 'kinetic_energy', 'std_msgs/msg/Float64', 'T (J).'),

@@ -17,7 +17,7 @@ def euler_rhs(moments, omega, torque=(0.0, 0.0, 0.0)):
     """
     Angular acceleration d(omega)/dt (rad/s^2, body frame) from Euler's equations.
 
-    Seed (4.26): tau_1 = I1 dw1/dt + (I3 - I2) w2 w3 and cyclic, i.e.
+    Shapiro (4.26): tau_1 = I1 dw1/dt + (I3 - I2) w2 w3 and cyclic, i.e.
     (4.25) tau = I dw/dt + w x (I w) in the principal frame.
     """
     i1, i2, i3 = moments

@@ -69,7 +69,7 @@ def body_precession_rate(t, omega, axis=2):
     Rate (rad/s) at which omega's perpendicular part turns about body axis ``axis``.
 
     Positive for a right-handed turn about +axis; compare with
-    theory.body_precession_rate (the seed's Omega).
+    theory.body_precession_rate (Shapiro's Omega).
     """
     w = np.asarray(omega, dtype=float)
     a, b = _perp_axes(axis)

@@ -74,7 +74,7 @@ class PrecessionFindings:
 
     ``kind``: 'axisymmetric', 'asymmetric', 'spherical', 'principal spin' or
     'unavailable'. Axisymmetric: ``body_rate`` (omega about the symmetry axis
-    in the body frame, the seed's Omega), ``lab_rate`` (the symmetry axis
+    in the body frame, Shapiro's Omega), ``lab_rate`` (the symmetry axis
     about L), the cone angles (rad). Asymmetric: ``omega_period`` (s) and
     ``mean_precession`` of the ``circled_axis`` about L (rad/s), measured over
     a whole number of periods of omega.

@@ -107,7 +107,7 @@ OTHER_KEYS = (
 ))
 #: What each quantity is, for the manual.
 MEANINGS = {
-    'body_rate': "axisymmetric: omega turning about the symmetry axis in the body (the seed's "
+    'body_rate': "axisymmetric: omega turning about the symmetry axis in the body (Shapiro's "
                  'Omega)',
     'lab_rate': 'axisymmetric: the symmetry axis turning about L, |L|/I_perp',
     'omega_period': 'asymmetric: the period of omega(t)',

@@ -387,7 +387,7 @@ def precession_rate(moments, omega_axis, h, axis=2):
     ``moments`` (kg m^2) with the two moments other than ``axis`` equal (I_perp),
     rotor momentum ``h`` = sum J Omega along ``axis`` (kg m^2/s), ``omega_axis`` the
     (constant) spin about it (rad/s): lambda = ((I_axis - I_perp) omega_axis + h) / I_perp,
-    counter-clockwise about +axis. With h = 0 it is the seed's body rate Omega.
+    counter-clockwise about +axis. With h = 0 it is Shapiro's body rate Omega.
     """
     others = [moments[k] for k in range(3) if k != axis]
     if not math.isclose(others[0], others[1], rel_tol=1e-12):

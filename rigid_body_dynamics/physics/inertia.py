@@ -248,10 +248,10 @@ def as_inertia(value):
 
 def ellipsoid_semi_axes(moments, kinetic_energy):
     """
-    Semi-axes (rad/s) of the seed's inertia ellipsoid omega . I omega = 2T.
+    Semi-axes (rad/s) of Shapiro's inertia ellipsoid omega . I omega = 2T.
 
     Along principal axis i the semi-axis is sqrt(2T / I_i): proportional to
-    1/sqrt(I_i) (Poinsot construction, seed section 4.4.1).
+    1/sqrt(I_i) (Poinsot construction, Shapiro section 4.4.1).
     """
     m = validate_moments(moments)
     return np.array([math.sqrt(2.0 * kinetic_energy / i) for i in m])

@@ -1,7 +1,7 @@
 """
 Closed-form predictions for the free rigid body.
 
-Each function cites where its formula comes from: the seed text (Shapiro,
+Each function cites where its formula comes from: Shapiro's textbook (J. A. Shapiro,
 Classical Mechanics, section 4.4, equation numbers as there) or is derived
 in its docstring from the exact solution of ``free_motion``. Units: kg m^2, rad/s, s, J,
 kg m^2/s; vectors in the principal body frame unless named ``_world``.
@@ -21,7 +21,7 @@ SIDEREAL_DAY = 86164.0905
 
 def body_precession_rate(i_perp, i_axis, omega_axis):
     """
-    Body-frame precession rate Omega = omega_3 (I3 - I1) / I1 (rad/s), seed after (4.26).
+    Body-frame precession rate Omega = omega_3 (I3 - I1) / I1 (rad/s), Shapiro after (4.26).
 
     For an axisymmetric body (I1 = I2 = ``i_perp``, symmetry moment ``i_axis``)
     omega's component perpendicular to the symmetry axis turns about +axis at
@@ -34,7 +34,7 @@ def lab_precession_rate(i_perp, angular_momentum_norm):
     """
     Lab-frame precession rate |L| / I_perp (rad/s) of the symmetry axis and of omega about L.
 
-    Equal to :func:`herpolhode_rate` (the seed's Omega sin(phi_b) / sin(phi_L)):
+    Equal to :func:`herpolhode_rate` (Shapiro's Omega sin(phi_b) / sin(phi_L)):
     the contact line's speed is the same seen from either cone.
     """
     return angular_momentum_norm / i_perp
@@ -45,9 +45,9 @@ class ConeAngles:
     """Half-angles (rad) of an axisymmetric body's free motion."""
 
     body: float
-    """phi_b: between omega and the symmetry axis (body cone), seed: tan phi_b = A / omega_3."""
+    """phi_b: between omega and the symmetry axis (body cone), Shapiro: tan phi_b = A / omega_3."""
     lab: float
-    """phi_L: between omega and L (lab cone), seed: cos phi_L = 2T / (|omega| |L|)."""
+    """phi_L: between omega and L (lab cone), Shapiro: cos phi_L = 2T / (|omega| |L|)."""
     nutation: float
     """theta: between L and the symmetry axis, tan theta = I_perp omega_perp / (I3 |omega_3|)."""
 
@@ -57,7 +57,7 @@ def cone_angles(i_perp, i_axis, omega_perp, omega_axis):
     Body-cone, lab-cone and nutation half-angles (rad) of an axisymmetric body.
 
     ``omega_perp`` >= 0 is the magnitude of omega perpendicular to the
-    symmetry axis (the seed's amplitude A), ``omega_axis`` the component along
+    symmetry axis (Shapiro's amplitude A), ``omega_axis`` the component along
     it. Angles via atan2 (no acos precision floor).
     """
     w_axis = abs(omega_axis)
@@ -70,7 +70,7 @@ def herpolhode_rate(i_perp, i_axis, omega_perp, omega_axis):
     """
     Rate (rad/s) at which the herpolhode turns about L: Omega sin(phi_b) / sin(phi_L).
 
-    The seed's rolling-without-slipping expression (Poinsot construction); it
+    Shapiro's rolling-without-slipping expression (Poinsot construction); it
     equals |L| / I_perp (:func:`lab_precession_rate`) whenever phi_L > 0.
     """
     cones = cone_angles(i_perp, i_axis, omega_perp, omega_axis)
@@ -82,7 +82,7 @@ def invariant_plane_distance(kinetic_energy, angular_momentum_norm):
     """
     Distance (rad/s) of the invariant plane from the origin in omega-space: 2T / |L|.
 
-    omega . L_hat = 2T / |L| is constant (seed, Poinsot construction).
+    omega . L_hat = 2T / |L| is constant (Shapiro, Poinsot construction).
     """
     return 2.0 * kinetic_energy / angular_momentum_norm
 
@@ -106,7 +106,7 @@ def axis_stability(moments, axis, spin):
     """
     Stability of a spin ``spin`` (rad/s) about principal axis ``axis`` (0, 1 or 2).
 
-    Seed "Stability of rotation about an axis": the perturbation obeys
+    Shapiro, "Stability of rotation about an axis": the perturbation obeys
     eps'' = s2 eps with s2 = -omega^2 (I_j - I_k)(I_j - I_l) / (I_k I_l);
     s2 < 0 is a wobble at sqrt(-s2), s2 > 0 growth at sqrt(s2) (intermediate
     axis), an equal moment the marginal case of linear growth.
@@ -214,7 +214,7 @@ def separatrix_growth_rate(moments, omega):
     Growth rate (1/s) of departures from a spin about the intermediate axis.
 
     omega_2 sqrt((I2 - I1)(I3 - I2) / (I1 I3)) with the intermediate axis'
-    component of omega (seed, stability; equals lambda on the separatrix).
+    component of omega (Shapiro, stability; equals lambda on the separatrix).
     """
     shape = BodyShape(validate_moments(moments))
     if shape.kind != 'asymmetric':
@@ -266,6 +266,6 @@ def chandler_wobble_period(spin_rate=2.0 * math.pi / SIDEREAL_DAY,
     Body-frame wobble period (s) of an oblate planet: 2 pi / Omega.
 
     Omega = omega_3 (I3 - I1) / I1 with (I3 - I1) / I1 = ``dynamical_ellipticity``
-    (seed: Earth, about 1/300, period about 300 sidereal days, "10 months").
+    (Shapiro: Earth, about 1/300, period about 300 sidereal days, "10 months").
     """
     return 2.0 * math.pi / (spin_rate * dynamical_ellipticity)
