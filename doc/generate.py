@@ -38,7 +38,8 @@ def pages():
 
 
 #: The sections that ``--only NAME`` does not measure, and the command that does.
-SECTION_COMMANDS = {'physics-accuracy': './dev bench', 'physics-torque': './dev bench --only torque',
+SECTION_COMMANDS = {'physics-accuracy': './dev bench',
+                    'physics-torque': './dev bench --only torque',
                     'peers': './dev bench --peers'}
 
 
