@@ -3,6 +3,7 @@
 import datetime
 import os
 import platform
+import subprocess
 
 import numpy as np
 from rigid_body_dynamics.physics import equations, FreeRigidBody, quaternions
@@ -21,6 +22,13 @@ def machine():
     except OSError:
         pass
     load = f', load average {os.getloadavg()[0]:.2f}' if hasattr(os, 'getloadavg') else ''
+    try:        # the commit measured (with + when the working tree differs from it)
+        here = os.path.dirname(os.path.abspath(__file__))
+        commit = subprocess.run(['git', 'describe', '--always', '--dirty=+'], cwd=here,
+                                capture_output=True, text=True, timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        commit = ''
+    load += f', commit {commit}' if commit else ''
     return (f'{datetime.date.today().isoformat()}, {cpu}, {os.cpu_count()} cores, '
             f'Python {platform.python_version()}, numpy {np.__version__}, '
             f'scipy {scipy.__version__}{load}')
