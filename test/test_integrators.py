@@ -141,7 +141,9 @@ def test_exact_picks_order_6_order_8_and_sub_steps_by_omega_h():
     assert max(errors.values()) < 2e-14, errors
 
 
-# --- The issue-10 cases at reduced length, against DOP853 restarted at every hold ---------
+# --- The held-torque cases at reduced length, against DOP853 restarted at every hold -----
+# README says 2e-13 rad at 1 and 10 ms (benchmarks, 20 s); measured here 1.5e-14 / 2.3e-14 at
+# 1 ms and 2.5e-15 / 5.3e-15 at 10 ms (T1 / T2): the README's figure is the bound.
 
 def test_open_loop_schedule_at_1_and_10_ms():
     """T1: tau(t_k) = (0.3 sin 0.7t, 0.2 cos 1.3t, 0.25 sin(0.4t + 1)), held 10 ms, 4 s."""
@@ -151,7 +153,7 @@ def test_open_loop_schedule_at_1_and_10_ms():
     for dt in (1e-3, 1e-2):
         attitude, omega, stepper = zoh_errors('exact', dt, MOMENTS, (0.3, 1.5, -0.4), Q0,
                                               0.01, 400, command)
-        assert attitude < 1e-11 and omega < 1e-11, (dt, attitude, omega)
+        assert attitude < 2e-13 and omega < 2e-13, (dt, attitude, omega)
 
 
 def test_closed_loop_pd_at_1_and_10_ms():
@@ -168,7 +170,7 @@ def test_closed_loop_pd_at_1_and_10_ms():
     for dt in (1e-3, 1e-2):
         attitude, omega, _ = zoh_errors('exact', dt, moments, (0.5, -0.8, 1.2), Q0, 0.01, 800,
                                         command)
-        assert attitude < 1e-11 and omega < 1e-11, (dt, attitude, omega)
+        assert attitude < 2e-13 and omega < 2e-13, (dt, attitude, omega)
     assert any(saturated) and not all(saturated)     # the limit is reached, then left
 
 
@@ -204,7 +206,13 @@ def test_a_torque_across_the_separatrix_keeps_its_accuracy():
 
 @pytest.mark.parametrize('world', [False, True])
 def test_balances_to_round_off_under_torque(world, rng):
-    """T - T0 = W (W by quadrature, so this checks accuracy) and L_w - L_w0 = H, <= 1e-13."""
+    """
+    Check T - T0 = W to 1e-13: W is a quadrature, so this measures accuracy.
+
+    L_w - L_w0 = H is checked too, but only as consistency: the integrator accumulates
+    H from the same stage torques it integrates, so it holds by construction. The world
+    torque's impulse is checked against its closed form tau_w t below.
+    """
     q0 = random_attitude(rng)
     stepper = make_integrator('exact', MOMENTS, 1e-3, q0, OMEGA0)
     t0, l0 = invariants(MOMENTS, q0, OMEGA0)
@@ -258,8 +266,9 @@ def test_world_torque_matches_the_reference_at_10_ms(rng):
         return equations.state_rhs(MOMENTS, y, quaternions.rotate_inverse(y[3:7], tau_w))
     y = solve_ivp(rhs, (0.0, 3.0), np.concatenate([OMEGA0, q0]), method='DOP853',
                   rtol=2.5e-14, atol=1e-16).y[:, -1]
-    assert float(quaternions.angle_between(stepper.q, y[3:7] / np.linalg.norm(y[3:7]))) < 1e-11
-    assert np.max(np.abs(np.array(stepper.omega) - y[:3])) < 1e-11 * np.linalg.norm(y[:3])
+    attitude = float(quaternions.angle_between(stepper.q, y[3:7] / np.linalg.norm(y[3:7])))
+    omega = np.max(np.abs(np.array(stepper.omega) - y[:3])) / np.linalg.norm(y[:3])
+    assert attitude < 2e-13 and omega < 2e-13, (attitude, omega)     # measured 2.8e-15, 2.0e-15
 
 
 # --- Torque-free after torque, the separatrix, protocol -----------------------------------
