@@ -16,6 +16,7 @@ from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
 from rcl_interfaces.srv import SetParametersAtomically
+from rclpy.duration import Duration
 from rclpy.parameter import Parameter
 from rigid_body_dynamics.physics import FreeRigidBody, presets, theory
 from rigid_body_dynamics.ros.conversions import vector_msg
@@ -386,14 +387,15 @@ def test_intake_takes_every_pending_message_in_order(probe):
     intake = Intake(probe.node)
     try:
         intake.subscribe(Odometry, 'intake_test', DEEP)
-        pub = probe.publisher(Odometry, 'intake_test')
-        probe.spin_for(0.5)                              # the reader learns of our writer
+        # a writer deep enough to hold all 200 until the reader acknowledges them
+        pub = probe.publisher(Odometry, 'intake_test', qos=DEEP)
         body = FreeRigidBody((1.0, 2.0, 3.0), (0.3, 1.5, -0.4))
         times = np.arange(200) * 0.01
         q, w = body.state_at(times)
         for k, t in enumerate(times):
             pub.publish(odom_msg(t, q[k], w[k]))
-        probe.spin_for(0.5)                              # spinning the probe takes nothing
+        assert pub.wait_for_all_acked(Duration(seconds=20.0))    # all 200 at the reader
+        probe.spin_for(0.2)                              # spinning the probe takes nothing
         raws = intake.take('intake_test')
         assert len(raws) == 200 and intake.take('intake_test') == []
         got = [deserialize_message(raw, Odometry) for raw in raws]
