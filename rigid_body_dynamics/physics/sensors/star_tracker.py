@@ -94,15 +94,16 @@ class StarTracker:
 
     def excluded(self, state, t):
         """Return why the view is blocked at ``state`` and t (s): 'sun', 'earth' or None."""
-        sky = state.sky
-        if self.sun_exclusion > 0.0 and sky.sun is not None:
-            if _angle(self.boresight(state.q), sky.sun_world(t)) < self.sun_exclusion:
-                return 'sun'
-        r = state.position
+        sky, r = state.sky, state.position
+        looks_at_sun = self.sun_exclusion > 0.0 and sky.sun is not None
+        if not looks_at_sun and r is None:
+            return None
+        boresight = self.boresight(state.q)
+        if looks_at_sun and _angle(boresight, sky.sun_world(t)) < self.sun_exclusion:
+            return 'sun'
         if r is not None:
             nadir = -np.asarray(r, dtype=float) / float(np.linalg.norm(r))
-            limb = sky.planet_angular_radius(r)
-            if _angle(self.boresight(state.q), nadir) < limb + self.earth_exclusion:
+            if _angle(boresight, nadir) < sky.planet_angular_radius(r) + self.earth_exclusion:
                 return 'earth'
         return None
 
