@@ -12,7 +12,7 @@ import time
 from common import errors, fmt
 import numpy as np
 from rigid_body_dynamics.physics import make_integrator
-from rigid_body_dynamics.physics.equations import state_rhs
+from rigid_body_dynamics.physics.dynamics.equations import state_rhs
 from scipy.integrate import solve_ivp
 
 MOMENTS = (1.0, 2.0, 3.0)

@@ -6,7 +6,8 @@ import platform
 import subprocess
 
 import numpy as np
-from rigid_body_dynamics.physics import equations, FreeRigidBody, quaternions
+from rigid_body_dynamics.physics import FreeRigidBody, quaternions
+from rigid_body_dynamics.physics.dynamics import equations
 import scipy
 
 

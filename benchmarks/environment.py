@@ -8,7 +8,7 @@ m^3/s^2 (Basilisk's Earth); the gravity gradient; the IGRF-13 centred dipole fie
 fixed in the world frame (Basilisk's centred dipole turns with the planet only through a
 SPICE planet message, none here), and magnetorquers along the body axes commanded every
 1 s, m_k = (3 sin 0.05k, 2 cos 0.07k, 1.5 sin(0.03k + 1)) A m^2, for 1000 s.
-Reference: ``physics.reference.space_zoh_reference``, scipy's DOP853 at rtol 2.5e-14 of
+Reference: ``physics.dynamics.reference.space_zoh_reference``, scipy's DOP853 at rtol 2.5e-14 of
 the same physics written apart (the orbit integrated as an ODE), restarted at every hold.
 Errors are the largest over the 1000 holds: attitude (rad), omega relative to the
 largest |omega|. Cost is wall time per simulated second. Ours: the engine
@@ -28,8 +28,8 @@ import numpy as np
 from peers import basilisk_attitude, basilisk_body
 from rigid_body_dynamics.engine import BodySimulation, DipoleCommands, Disturbances
 from rigid_body_dynamics.physics import Inertia, quaternions
+from rigid_body_dynamics.physics.dynamics.reference import space_zoh_reference
 from rigid_body_dynamics.physics.environment import DipoleField, KeplerOrbit
-from rigid_body_dynamics.physics.reference import space_zoh_reference
 
 MU = 3.986004415e14
 ELEMENTS = (7.0e6, 0.01, 1.7, 0.8, 0.3, 0.2)

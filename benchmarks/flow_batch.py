@@ -14,7 +14,7 @@ bodies of one phase of a fleet it would not; over the next 64 reads of one body 
 import time
 
 import numpy as np
-from rigid_body_dynamics.physics.free_motion import BodyShape
+from rigid_body_dynamics.physics.dynamics.free_motion import BodyShape
 
 
 def _least(run, repeat, rounds=5):

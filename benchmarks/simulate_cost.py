@@ -26,7 +26,7 @@ import time
 from common import best_of, fmt
 import numpy as np
 from rigid_body_dynamics.physics import Inertia, quaternions, simulate
-from rigid_body_dynamics.physics.reference import zoh_reference
+from rigid_body_dynamics.physics.dynamics.reference import zoh_reference
 from scipy.spatial.transform import Rotation
 import torque
 

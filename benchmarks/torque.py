@@ -35,7 +35,7 @@ import numpy as np
 from peers import basilisk_attitude, basilisk_body, mujoco_body
 from rigid_body_dynamics.physics import make_integrator, quaternions, simulate
 from rigid_body_dynamics.physics.control import QuaternionPD
-from rigid_body_dynamics.physics.reference import zoh_reference
+from rigid_body_dynamics.physics.dynamics.reference import zoh_reference
 
 HOLD = 0.01
 DURATION = 20.0

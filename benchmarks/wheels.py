@@ -2,7 +2,7 @@
 Reaction wheels side by side with Basilisk: accuracy against DOP853 and cost.
 
 Two cases, each against scipy's DOP853 of the gyrostat at rtol 2.5e-14,
-restarted at every 10 ms hold (``physics.reference.gyrostat_zoh_reference``):
+restarted at every 10 ms hold (``physics.dynamics.reference.gyrostat_zoh_reference``):
 
 - W1 torque-free gyrostat: I = (1, 2, 3) kg m^2 (wheels locked in), three wheels on the
   principal axes, J = 0.05 kg m^2 each, spinning at (100, -50, 20) rad/s with no motor
@@ -32,8 +32,8 @@ from common import best_of, fmt
 import numpy as np
 from rigid_body_dynamics.physics import quaternions
 from rigid_body_dynamics.physics.control import QuaternionPD, WheelAllocator
-from rigid_body_dynamics.physics.gyrostat import GyrostatIntegrator, Wheels
-from rigid_body_dynamics.physics.reference import gyrostat_zoh_reference
+from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator, Wheels
+from rigid_body_dynamics.physics.dynamics.reference import gyrostat_zoh_reference
 
 HOLD = 0.01
 DURATION = 20.0

@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pytest
 from rigid_body_dynamics.physics import quaternions
-from rigid_body_dynamics.physics.equations import state_rhs
+from rigid_body_dynamics.physics.dynamics.equations import state_rhs
 from scipy.integrate import solve_ivp
 
 

@@ -1,12 +1,12 @@
-"""The one analysis (physics/analysis.py): findings against closed forms, statuses, defects."""
+"""The one analysis (physics/analysis/): findings against closed forms, statuses, defects."""
 
 import math
 
 import numpy as np
 import pytest
-from rigid_body_dynamics.physics import FreeRigidBody, presets, simulate, theory
-from rigid_body_dynamics.physics.analysis import (analyse, ERROR, OK, Trajectory, UNAVAILABLE,
-                                                  WARN)
+from rigid_body_dynamics.physics import FreeRigidBody, presets, simulate
+from rigid_body_dynamics.physics.analysis import (analyse, ERROR, OK, theory, Trajectory,
+                                                  UNAVAILABLE, WARN)
 
 #: 2026-12-01 in ns since 1970: stamps as a live system has them
 EPOCH_2026 = 1_764_547_200_000_000_000
@@ -226,7 +226,7 @@ def wheel_trajectory(duration=10.0, inertia_error=1.0):
 
     ``inertia_error`` scales the wheel inertia the analysis is told (1: the true one).
     """
-    from rigid_body_dynamics.physics.gyrostat import GyrostatIntegrator, Wheels
+    from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator, Wheels
     axes = [c / math.sqrt(3.0) for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
             for c in g]
     wheels = Wheels(axes, (0.02,) * 4, coulomb=(1e-4,) * 4, viscous=(1e-6,) * 4)
@@ -267,7 +267,7 @@ def test_the_analyzers_diagnostics_read_back_into_the_same_findings():
     Findings, printed by the one text renderer: the same lines as the findings printed
     directly, for every kind of finding. A key renamed on one side only fails here.
     """
-    from rigid_body_dynamics.physics.findings_render import table_rows, text_lines
+    from rigid_body_dynamics.physics.analysis.findings_render import table_rows, text_lines
     from rigid_body_dynamics.nodes import analyzer_diagnostics as diagnostics
     from rigid_body_dynamics.ros.conversions import status_values
     seen = set()
@@ -282,7 +282,7 @@ def test_the_analyzers_diagnostics_read_back_into_the_same_findings():
         assert table_rows(back) == table_rows(found), case
     # every key written is in the manual's table (made from the same module)
     import re
-    from rigid_body_dynamics.physics.findings_render import reference_rows
+    from rigid_body_dynamics.physics.analysis.findings_render import reference_rows
     listed = [re.escape(key).replace('<axis>', '[1-3]') for _sec, key, _m in reference_rows()]
     assert [k for k in seen if not any(re.fullmatch(p, k) for p in listed)] == []
     # every quantity of the reader's table was written by some case, with its unit
@@ -300,7 +300,7 @@ def test_the_analyzers_diagnostics_read_back_into_the_same_findings():
 
 def _free_gyrostat(moments, axes, j, speeds0, omega0, duration, dt=1e-2):
     """Sample a torque-free gyrostat at ``dt`` (the motors off): a Trajectory with wheels."""
-    from rigid_body_dynamics.physics.gyrostat import GyrostatIntegrator, Wheels
+    from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator, Wheels
     wheels = Wheels(axes, j)
     body = GyrostatIntegrator(moments, wheels, dt, omega0=omega0, speeds0=speeds0)
     rows = [(0, body.q, body.omega, body.speeds)]

@@ -18,7 +18,8 @@ import pytest
 from rcl_interfaces.srv import SetParametersAtomically
 from rclpy.duration import Duration
 from rclpy.parameter import Parameter
-from rigid_body_dynamics.physics import FreeRigidBody, presets, theory
+from rigid_body_dynamics.physics import FreeRigidBody, presets
+from rigid_body_dynamics.physics.analysis import theory
 from rigid_body_dynamics.ros.conversions import vector_msg
 from ros_harness import analyzer_heard, odom_msg
 from std_msgs.msg import Float64

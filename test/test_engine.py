@@ -40,7 +40,7 @@ def make_body(**kwargs):
 def test_the_physics_the_engine_and_the_messages_import_no_ros():
     code = ('import sys, rigid_body_dynamics.physics, rigid_body_dynamics.engine; '
             'import rigid_body_dynamics.physics.environment; '
-            'import rigid_body_dynamics.physics.findings_render; '
+            'import rigid_body_dynamics.physics.analysis.findings_render; '
             'import rigid_body_dynamics.messages.bags, rigid_body_dynamics.messages.cdr; '
             'print(sorted(m for m in sys.modules if m == "rclpy" or m.startswith('
             '("rclpy.", "rosidl_runtime_py", "rigid_body_dynamics.ros"))))')
@@ -417,7 +417,7 @@ def test_disturbances_are_summed_into_the_integrated_and_reported_torque():
     # an integrator change mid-run keeps the orbit's clock (the environment's epoch)
     with body.lock:
         body.configure(integrator='rk4')
-        assert body._field.epoch == pytest.approx(0.1)
+        assert body.plant.field.epoch == pytest.approx(0.1)
 
 
 def test_loop_publishes_within_its_budget_and_schedules_diagnostics():
@@ -560,7 +560,7 @@ def test_a_batch_of_commands_counts_and_holds_as_one_by_one():
 # --- Reaction wheels through the one command path ---------------------------------------------
 
 def _wheels():
-    from rigid_body_dynamics.physics.gyrostat import Wheels
+    from rigid_body_dynamics.physics.dynamics.gyrostat import Wheels
     pyramid = [c / math.sqrt(3.0) for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
                for c in g]
     return Wheels(pyramid, (0.02,) * 4, max_torque=(0.05,) * 4, max_speed=(200.0,) * 4,
@@ -570,7 +570,7 @@ def _wheels():
 def test_wheel_commands_act_from_their_step_as_offline_and_bad_ones_are_counted():
     """Paced wheel commands (with bad ones) = a gyrostat stepped offline at the same deadlines."""
     from rigid_body_dynamics.engine import WheelCommands
-    from rigid_body_dynamics.physics.gyrostat import GyrostatIntegrator
+    from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator
     clock = FakeClock()
     t0 = clock.ns
     rng = np.random.default_rng(8)
@@ -626,7 +626,7 @@ def test_wheel_commands_time_out_like_the_torque_and_reset_restores_the_speeds()
 def test_lockstep_with_wheels_a_wheel_command_answers_the_tick():
     """Bit for bit: the state after three ticks equals a gyrostat stepped offline with them."""
     from rigid_body_dynamics.engine import Lockstep, WheelCommands
-    from rigid_body_dynamics.physics.gyrostat import GyrostatIntegrator
+    from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator
     clock = FakeClock()
     wheels = _wheels()
     body = make_body(wheels=wheels, torque_timeout=0.0, publish_every=5)

@@ -5,7 +5,7 @@ The Kepler orbit against the two-body ODE and the conic's invariants, the LVLH
 frame, the dipole field against its formula in the Earth-fixed frame, the
 torque models against numpy, the whole model (orbit, gravity gradient, field,
 residual dipole, magnetorquer commands held) through the engine against
-physics.reference's DOP853 of the same physics written apart, and the
+physics.dynamics.reference's DOP853 of the same physics written apart, and the
 gravity-gradient pitch libration against its theory.
 """
 
@@ -15,11 +15,12 @@ import numpy as np
 import pytest
 from rigid_body_dynamics.engine import BodySimulation, Disturbances
 from rigid_body_dynamics.engine.commands import DipoleCommands
-from rigid_body_dynamics.physics import estimators, Inertia, make_integrator, quaternions
+from rigid_body_dynamics.physics import Inertia, make_integrator, quaternions
+from rigid_body_dynamics.physics.analysis import estimators
+from rigid_body_dynamics.physics.dynamics.reference import space_zoh_reference
 from rigid_body_dynamics.physics.environment import (
     circular_elements, DipoleField, GravityGradient, KeplerOrbit, lvlh_axes, lvlh_quaternion,
     MagneticDipole, MU_EARTH, SpaceEnvironment)
-from rigid_body_dynamics.physics.reference import space_zoh_reference
 from rigid_body_dynamics.physics.sensors import Magnetometer
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
@@ -221,9 +222,9 @@ def test_magnetorquer_commands_refused_held_and_timed_out():
         assert body.dipole_held[0] == (1e3, 0.0, 0.0)
         outbox = []
         body.advance(10 ** 6, outbox)                  # within the timeout: held
-        assert body._field is not None and body.snapshot().dipole == (1e3, 0.0, 0.0)
+        assert body.plant.field is not None and body.snapshot().dipole == (1e3, 0.0, 0.0)
         body.advance(60 * 10 ** 6, outbox)             # 60 ms later: timed out, zero, free
-        assert body.snapshot().dipole == (0.0, 0.0, 0.0) and body._field is None
+        assert body.snapshot().dipole == (0.0, 0.0, 0.0) and body.plant.field is None
         assert any('magnetorquer command timed out' in n for n in body.take_notes())
     assert body.dipole_counts == {'accepted': 1, 'rejected_non_finite': 1, 'rejected_frame': 0,
                                   'clipped': 0, 'stale': 0}
@@ -313,8 +314,8 @@ def test_a_body_with_reaction_wheels_in_orbit_against_an_independent_dop853():
     with the torques of reference.space_rhs (numpy, the orbit as an ODE) added: q, omega and
     the wheel speeds within 1e-12 over 20 s at 10 ms.
     """
-    from rigid_body_dynamics.physics.gyrostat import Wheels
-    from rigid_body_dynamics.physics.reference import gyrostat_rhs, space_rhs
+    from rigid_body_dynamics.physics.dynamics.gyrostat import Wheels
+    from rigid_body_dynamics.physics.dynamics.reference import gyrostat_rhs, space_rhs
     axes = [c / math.sqrt(3.0) for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
             for c in g]
     wheels = Wheels(axes, (0.02,) * 4)

@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from rigid_body_dynamics.physics import estimators, FreeRigidBody, simulate, theory
+from rigid_body_dynamics.physics import FreeRigidBody, simulate
+from rigid_body_dynamics.physics.analysis import estimators, theory
 
 MOMENTS = (1.0, 1.0, 1.5)
 OMEGA0 = (0.5, 0.0, 10.0)   # Omega = 5 rad/s

@@ -3,8 +3,9 @@
 from conftest import dop853_reference, random_attitude
 import numpy as np
 import pytest
-from rigid_body_dynamics.physics import equations, FreeRigidBody, quaternions
-from rigid_body_dynamics.physics.free_motion import BodyShape
+from rigid_body_dynamics.physics import FreeRigidBody, quaternions
+from rigid_body_dynamics.physics.dynamics import equations
+from rigid_body_dynamics.physics.dynamics.free_motion import BodyShape
 
 # (moments, omega0): both polhode families, both signs of the circled
 # component, every ordering of the axes (even and odd permutations).

@@ -1,8 +1,8 @@
 """
-The gyrostat (physics/gyrostat.py): a body with reaction wheels, against independent references.
+The gyrostat (dynamics/gyrostat.py): a body with reaction wheels, against independent references.
 
 The reference is scipy's DOP853 at rtol 1e-13 on the model written again with numpy
-(physics.reference.gyrostat_rhs: np.linalg.solve of the coupled equations), not our
+(physics.dynamics.reference.gyrostat_rhs: np.linalg.solve of the coupled equations), not our
 scalar code; closed forms for the
 axisymmetric precession and the viscous spin-down; the linear stability theory for a
 spin with rotor momentum. Tolerances are stated at each assertion.
@@ -12,9 +12,10 @@ import math
 
 import numpy as np
 import pytest
-from rigid_body_dynamics.physics.gyrostat import (GyrostatIntegrator, precession_rate,
-                                                  spin_stability, Wheels)
-from rigid_body_dynamics.physics.reference import gyrostat_rhs
+from rigid_body_dynamics.physics.dynamics.gyrostat import (GyrostatIntegrator,
+                                                           precession_rate, spin_stability,
+                                                           Wheels)
+from rigid_body_dynamics.physics.dynamics.reference import gyrostat_rhs
 from scipy.integrate import solve_ivp
 
 PYRAMID = tuple(tuple(c / math.sqrt(3.0) for c in g) for g in

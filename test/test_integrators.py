@@ -5,12 +5,12 @@ import math
 from conftest import dop853_reference, random_attitude
 import numpy as np
 import pytest
-from rigid_body_dynamics.physics import equations, FreeRigidBody, INTEGRATORS, make_integrator
-from rigid_body_dynamics.physics import quaternions
+from rigid_body_dynamics.physics import FreeRigidBody, INTEGRATORS, make_integrator, quaternions
 from rigid_body_dynamics.physics.control import QuaternionPD
-from rigid_body_dynamics.physics.integrators import rk_constants
-from rigid_body_dynamics.physics.reference import zoh_reference
-from rigid_body_dynamics.physics.rk_kernels import KERNELS
+from rigid_body_dynamics.physics.dynamics import equations
+from rigid_body_dynamics.physics.dynamics.integrators import rk_constants
+from rigid_body_dynamics.physics.dynamics.reference import zoh_reference
+from rigid_body_dynamics.physics.dynamics.rk_kernels import KERNELS
 
 MOMENTS = (1.0, 2.0, 3.0)
 OMEGA0 = (1.0, 1.0, 6.0)   # |omega| h = 6e-3 at 1 kHz, as in the acceptance targets
@@ -369,8 +369,8 @@ def test_unknown_removed_integrator_and_bad_state_are_refused():
 
 
 def test_our_dop853_tableau_is_scipys_bit_for_bit():
-    """The order-8 tableau is ours (physics/dop853_tableau.py, source cited); scipy's agrees."""
-    from rigid_body_dynamics.physics import dop853_tableau as ours
+    """The order-8 tableau is ours (dynamics/dop853_tableau.py, source cited); scipy's agrees."""
+    from rigid_body_dynamics.physics.dynamics import dop853_tableau as ours
     from scipy.integrate._ivp import dop853_coefficients as scipys   # private: test only
     n = scipys.N_STAGES
     assert len(ours.A) == len(ours.B) == len(ours.C) == n == 12

@@ -1,8 +1,9 @@
-"""The momentum-sphere curves (physics/momentum_sphere.py) against both surfaces and a run."""
+"""The momentum-sphere curves (analysis/momentum_sphere.py) against both surfaces and a run."""
 
 import numpy as np
 import pytest
-from rigid_body_dynamics.physics import momentum_sphere, simulate
+from rigid_body_dynamics.physics import simulate
+from rigid_body_dynamics.physics.analysis import momentum_sphere
 
 MOMENTS = np.array([1.0, 2.0, 3.0])
 

@@ -5,8 +5,8 @@ import math
 from conftest import dop853_reference
 from hypothesis import given, settings, strategies as st
 import numpy as np
-from rigid_body_dynamics.physics import equations, FreeRigidBody, make_integrator
-from rigid_body_dynamics.physics import quaternions, theory
+from rigid_body_dynamics.physics import FreeRigidBody, make_integrator, quaternions, theory
+from rigid_body_dynamics.physics.dynamics import equations
 from scipy.integrate import solve_ivp
 
 

@@ -6,7 +6,7 @@ from bag_writers import rosbags_messages, write_rosbags
 import numpy as np
 import pytest
 from rigid_body_dynamics.messages.bags import read_trajectory
-from rigid_body_dynamics.physics import theory
+from rigid_body_dynamics.physics.analysis import theory
 from rigid_body_dynamics.tools import report
 
 

@@ -14,7 +14,7 @@ from geometry_msgs.msg import Vector3Stamped
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
-from rigid_body_dynamics.physics.gyrostat import GyrostatIntegrator, Wheels
+from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator, Wheels
 from rigid_body_dynamics.ros.conversions import time_ns, vector_array
 from ros_harness import odom_arrays, stamp
 from sensor_msgs.msg import JointState

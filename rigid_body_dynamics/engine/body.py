@@ -32,10 +32,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .commands import TorqueCommands
-from ..physics import make_integrator, quaternions
-from ..physics.environment import (GravityGradient, MagneticDipole, Magnetorquers, R_EARTH,
-                                   SpaceEnvironment)
-from ..physics.gyrostat import GyrostatIntegrator
+from ..physics.dynamics.plant import Plant
+from ..physics.environment import Disturbances
 from ..physics.sensors import BodyTruth, Sky, stream_rng
 
 _ZERO = (0.0, 0.0, 0.0)
@@ -59,46 +57,6 @@ class TorqueCommand:
     received_ns: int
     principal: object   # the body vector in the principal frame (None for a world command)
     stamp_ns: object = None   # the command's header stamp (int ns), if it has one
-
-
-@dataclass(frozen=True)
-class Disturbances:
-    """
-    The environment and its disturbance torques, summed into the commanded torque (N m).
-
-    ``body``: constant in the body frame; ``world``: constant in the world
-    frame; ``orbit``: a :class:`~rigid_body_dynamics.physics.environment.KeplerOrbit`
-    (None = no orbit); ``field``: a
-    :class:`~rigid_body_dynamics.physics.environment.DipoleField` (None = none);
-    ``gravity_gradient``: its torque on the orbit; ``residual_dipole`` (A m^2,
-    body frame): the torque m x B in the field. ``sun`` (a
-    :class:`~rigid_body_dynamics.physics.environment.Sun`, None = none) and
-    ``planet_radius`` (m) are what the sensors see (the Sun, the shadow, the
-    Earth's disc); they make no torque.
-    """
-
-    body: tuple = _ZERO
-    world: tuple = _ZERO
-    orbit: object = None
-    field: object = None
-    gravity_gradient: bool = False
-    residual_dipole: tuple = _ZERO
-    sun: object = None
-    planet_radius: float = R_EARTH
-
-    @property
-    def active(self):
-        """Whether any disturbance torque acts."""
-        return bool(any(self.body) or any(self.world) or self.gravity_gradient
-                    or any(self.residual_dipole))
-
-    def __str__(self):
-        parts = [f'{name} {value}' for name, value in (
-            ('body torque', self.body), ('world torque', self.world),
-            ('residual dipole', self.residual_dipole)) if any(value)]
-        if self.gravity_gradient:
-            parts.append('gravity gradient')
-        return ', '.join(parts) or 'none'
 
 
 class SensorSample(NamedTuple):
@@ -272,7 +230,7 @@ class BodySimulation:
     steps, at least 1) and the ``seed`` of their streams, ``start_ns`` (stamp of
     simulated time 0), ``disturbances``
     (:class:`Disturbances`; None = none), ``wheels`` (a
-    :class:`~rigid_body_dynamics.physics.gyrostat.Wheels` in the body frame, or None)
+    :class:`~rigid_body_dynamics.physics.dynamics.gyrostat.Wheels` in the body frame, or None)
     and their ``wheel_speeds`` at the start (rad/s; default 0): with wheels the body is
     a gyrostat and its motor torques are commands of their own (``WheelCommands``),
     held and timed out like the torque. ``magnetorquers`` (A m^2 per body axis, 0 =
@@ -341,11 +299,8 @@ class BodySimulation:
         """Back to the initial state at simulated time 0, no command, not paused."""
         with self.lock:
             q0, w0 = self.initial
-            body = self.inertia
-            self.stepper = self._make_stepper(body.attitude_to_principal(np.asarray(q0, float)),
-                                              body.to_principal(np.asarray(w0, float)),
-                                              self.wheel_speeds0)
-            self.steps = 0
+            self.plant = Plant(self.inertia, self.integrator_name, self.dt, q0, w0,
+                               self.disturbances, self.wheels, self.wheel_speeds0)
             self.paused = False
             self.command_held = None
             self.timed_out = False
@@ -354,61 +309,28 @@ class BodySimulation:
             self.dipole_held = None          # (body vector, received_ns, stamp_ns)
             self.dipole_timed_out = False
             self._motors_given = None        # the motor torques the stepper holds
-            self._dipole_given = _ZERO       # the dipole (body) the environment holds
-            self._held = (_ZERO, None, None)
             # the same seeds: the same streams after a reset
             self._streams = []
             for every, sensor in self.sensors:
                 rng = stream_rng(self.seed, sensor.stream)
                 sensor.start(rng, self.rate / every)
                 self._streams.append(rng)
-            self._disturb()
             self._baseline()
 
-    def _make_stepper(self, q_principal, omega_principal, speeds=None, angles=None):
-        """
-        Return the stepper of the state given in the principal frame (call under lock).
+    @property
+    def stepper(self):
+        """Return the integrator of the body's plant (its state in the principal frame)."""
+        return self.plant.stepper
 
-        A gyrostat (order 8, or RK4 for integrator ``rk4``) when the body has wheels.
-        """
-        if self.wheels is None:
-            return make_integrator(self.integrator_name, self.inertia.moments, self.dt,
-                                   q_principal, omega_principal)
-        turn = self.inertia.to_principal
-        stepper = GyrostatIntegrator(
-            self.inertia.moments, self.wheels.turned(lambda g: turn(np.array(g))), self.dt,
-            q_principal, omega_principal, speeds,
-            method='rk4' if self.integrator_name == 'rk4' else 'exact')
-        if angles is not None:
-            stepper.angles = tuple(angles)
-        return stepper
+    @property
+    def steps(self):
+        """Return the steps since simulated time 0."""
+        return self.plant.steps
 
-    def _disturb(self):
-        """Set up the disturbances for the current inertia and stepper (call under lock)."""
-        d, body = self.disturbances, self.inertia
-        self._dist_body = tuple(float(c) for c in body.to_principal(np.array(d.body))) \
-            if any(d.body) else None
-        self._dist_world = tuple(float(c) for c in d.world) if any(d.world) else None
-        models = []
-        if d.gravity_gradient:
-            models.append(GravityGradient(body.moments, d.orbit.mu))
-        if any(d.residual_dipole):
-            models.append(MagneticDipole(self._principal(d.residual_dipole)))
-        self._magnetorquers = None
-        if any(self._dipole_given):
-            self._magnetorquers = Magnetorquers()
-            self._magnetorquers.set_dipole(self._principal(self._dipole_given))
-            models.append(self._magnetorquers)
-        # the stepper's time starts at 0 when it is made: the environment is told the offset
-        self._field = SpaceEnvironment(
-            d.orbit, d.field, models, epoch=(self.steps - self.stepper.steps) * self.dt) \
-            if models else None
-
-    def _principal(self, vector):
-        """Return a body-frame vector in the principal frame, as a tuple of floats."""
-        if self.inertia.is_principal_frame:
-            return tuple(float(c) for c in vector)
-        return tuple(float(c) for c in self.inertia.to_principal(np.array(vector)))
+    @property
+    def _dipole_given(self):
+        """Return the dipole (A m^2, body frame) the environment holds."""
+        return self.plant.dipole
 
     def _baseline(self):
         """Remember T and L_w now: drift is reported since the last torque or change."""
@@ -426,10 +348,44 @@ class BodySimulation:
 
         Call under ``lock``.
         """
-        s, body = self.stepper, self.inertia
-        if body.is_principal_frame:
-            return s.q, s.omega
-        return body.attitude_to_body(np.array(s.q)), body.to_body(np.array(s.omega))
+        return self.plant.body_state()
+
+    def restart(self, time=True, state=True):
+        """
+        Go back to simulated time 0 and/or the initial state; keeps paused or not.
+
+        Both: as :meth:`reset` (commands dropped, sensor streams from their
+        seeds). ``state`` alone: the initial attitude, angular velocity and
+        wheel speeds at the current time (commands and streams kept). ``time``
+        alone: the current state at time 0 (the environment's clock restarts).
+        """
+        with self.lock:
+            paused = self.paused
+            if time and state:
+                self.reset()
+            elif state or time:
+                s = self.stepper
+                if state:
+                    (q, omega), speeds, angles = self.initial, self.wheel_speeds0, None
+                else:
+                    (q, omega) = self.body_state()
+                    speeds, angles = getattr(s, 'speeds', None), getattr(s, 'angles', None)
+                self.plant.restart(q, omega, speeds, angles, steps=0 if time else None)
+                self._motors_given = None            # the new stepper holds none yet
+                self._baseline()
+            self.paused = paused
+
+    def set_state(self, q, omega):
+        """
+        Set the attitude q (x, y, z, w, unit) and angular velocity omega (rad/s), body frame.
+
+        At the current simulated time; the wheels keep their speeds and angles.
+        """
+        with self.lock:
+            s = self.stepper
+            self.plant.restart(q, omega, getattr(s, 'speeds', None), getattr(s, 'angles', None))
+            self._motors_given = None
+            self._baseline()
 
     def set_paused(self, paused):
         """Freeze (True) or resume (False); returns whether it was paused before."""
@@ -461,14 +417,12 @@ class BodySimulation:
             if disturbances is not None and disturbances != self.disturbances:
                 self.disturbances = d = disturbances
                 self.sky = Sky(d.field, d.sun, d.planet_radius)
-                self._disturb()
+                self.plant.set_disturbances(d)
                 self._base_stale = True
                 lines.append(f'disturbances now {disturbances}')
             rebuild = False
             if inertia is not None and inertia is not self.inertia:
-                q_b, w_b = self.body_state()
                 self.inertia = inertia
-                self.stepper.reset(inertia.attitude_to_principal(q_b), inertia.to_principal(w_b))
                 rebuild = True
                 lines.append(f'inertia now {inertia.moments.tolist()} kg m^2 ({inertia.kind}); '
                              'attitude and angular velocity kept')
@@ -477,11 +431,8 @@ class BodySimulation:
                 rebuild = True
                 lines.append(f'integrator now {integrator}, continuing from the current state')
             if rebuild:
-                old = self.stepper
-                self.stepper = self._make_stepper(old.q, old.omega, getattr(old, 'speeds', None),
-                                                  getattr(old, 'angles', None))
+                self.plant.rebuild(self.inertia, self.integrator_name)
                 self._motors_given = None            # the new stepper holds none yet
-                self._disturb()
                 self._baseline()
                 cmd = self.command_held
                 if cmd is not None:
@@ -491,12 +442,8 @@ class BodySimulation:
 
     # ------------------------------------------------------------------ torque
     def _make_command(self, vector, world, received_ns, stamp_ns=None):
-        if world:
-            principal = None
-        elif self.inertia.is_principal_frame:     # (no numpy: a flood makes 1000 a second)
-            principal = tuple(float(c) for c in vector)
-        else:
-            principal = tuple(float(c) for c in self.inertia.to_principal(np.array(vector)))
+        # (no numpy: a flood makes 1000 a second; the plant's frame, as simulate() turns one)
+        principal = None if world else self.plant.principal(vector)
         return TorqueCommand(tuple(vector), world, received_ns, principal, stamp_ns)
 
     def check(self, commands):
@@ -695,33 +642,24 @@ class BodySimulation:
     def advance(self, now_ns, outbox):
         """One integration step (call under ``lock``); a publish tick's snapshot goes to outbox."""
         torque, torque_world = self.torque_now(now_ns)
-        if self._dist_body is not None:
-            torque = tuple(a + b for a, b in zip(torque, self._dist_body))
-        if self._dist_world is not None:
-            torque_world = self._dist_world if torque_world is None else tuple(
-                a + b for a, b in zip(torque_world, self._dist_world))
+        plant = self.plant
         if self.max_dipole is not None:
             dipole = self.dipole_now(now_ns)
-            if dipole is not self._dipole_given:      # (a new command, or its timeout)
-                self._dipole_given = dipole
-                self._disturb()
-        field = self._field
-        torqued = (field is not None or torque_world is not None or torque[0] or torque[1]
+            if dipole is not plant.dipole:      # (a new command, or its timeout)
+                plant.set_dipole(dipole)
+        torqued = (plant.disturbed or torque_world is not None or torque[0] or torque[1]
                    or torque[2])
         if self.wheels is not None:
             motors = self.motor_torques_now(now_ns)
             if motors is not self._motors_given:     # (checked once, when it was held)
-                self.stepper.command_motors(motors)
+                plant.command_motors(motors)
                 self._motors_given = motors
             # motor torques and friction change T (not H): no free-motion drift baseline
             torqued = torqued or self._wheel_friction or any(motors)
         if self._base_stale and not torqued:
             self._baseline()          # the state after the last step under torque
-        self.stepper.step(torque, torque_world, field)
-        self.steps += 1
+        plant.step(torque, torque_world)
         self._base_stale = self._base_stale or bool(torqued)
-        # the body torque of this step, in full only when a snapshot asks (not every step)
-        self._held = (torque, torque_world, field)
         self._ticks(outbox)
 
     def _make_schedule(self):
@@ -765,8 +703,7 @@ class BodySimulation:
         until read) and the ticks among them go to ``outbox``: the same state
         and items as ``count`` calls of :meth:`advance`.
         """
-        if self._dist_body is not None or self._dist_world is not None or \
-                self._field is not None or self.wheels is not None:
+        if self.plant.disturbed or self.wheels is not None:
             return False
         if self.command_held is not None:
             self.torque_now(now_ns)            # the watchdog, as the first step would ask it
@@ -776,11 +713,9 @@ class BodySimulation:
             return False
         if self._base_stale:
             self._baseline()                   # the state after the last step under torque
-        self._held = (_ZERO, None, None)
         while count > 0:
             run = min(self.steps_to_tick(), count)
-            self.stepper.free_steps(run)
-            self.steps += run
+            self.plant.free_steps(run)
             count -= run
             self._ticks(outbox)
         return True
@@ -824,23 +759,8 @@ class BodySimulation:
 
     @property
     def last_torque(self):
-        """
-        Principal-frame body torque (N m) of the last step, as reported (zero before one).
-
-        The held body part, plus the world part and the field (gravity gradient)
-        evaluated at the state at the end of the step.
-        """
-        torque, torque_world, field = self._held
-        if torque_world is None and field is None:
-            return torque
-        q = self.stepper.q
-        if torque_world is not None:
-            w = quaternions.rotate_components((-q[0], -q[1], -q[2], q[3]), torque_world)
-            torque = (torque[0] + w[0], torque[1] + w[1], torque[2] + w[2])
-        if field is not None:
-            f = field(self.stepper.time, *q, *self.stepper.omega)
-            torque = (torque[0] + f[0], torque[1] + f[1], torque[2] + f[2])
-        return torque
+        """Principal-frame body torque (N m) of the last step, as reported (zero before one)."""
+        return self.plant.last_torque
 
     def snapshot(self, odom_only=False):
         """Take the current :class:`Snapshot` (call under ``lock``)."""

@@ -206,6 +206,19 @@ class Pace:
                 self._hold_all()
             return max(0.0, (self.deadline(self._next_target()) - self.clock()) / _NS)
 
+    def step_paused(self, count, outbox):
+        """
+        Integrate ``count`` steps now, while the body is paused (call under the body's lock).
+
+        The commands that came are held first, as a wake holds them; the steps
+        are the ones a run would make (what ROS 2's StepSimulation asks).
+        """
+        self._hold_all()
+        now = self.clock()
+        body = self.body
+        for _ in range(count):
+            body.advance(now, outbox)
+
     def deadline(self, step):
         """Steady time (int ns) at which step number ``step`` (the one ending there) is due."""
         period = self.body.dt_ns / self.rtf

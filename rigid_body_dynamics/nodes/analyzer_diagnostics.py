@@ -3,16 +3,16 @@ Findings of the analysis -> diagnostic_msgs/DiagnosticStatus (REP 107) for attit
 
 Status names are ``<node>: conservation``, ``<node>: precession`` and
 ``<node>: stability`` (and ``<node>: orbit`` with ``gravity_gradient``); their values are
-:func:`~rigid_body_dynamics.physics.findings_render.key_values` (the one rendering
+:func:`~rigid_body_dynamics.physics.analysis.findings_render.key_values` (the one rendering
 of findings to key/values, whose keys the manual's attitude_analyzer page lists),
 and :func:`findings_from` reads them back with
-:func:`~rigid_body_dynamics.physics.findings_render.from_key_values`.
+:func:`~rigid_body_dynamics.physics.analysis.findings_render.from_key_values`.
 ``unavailable`` findings are level OK with the reason as the message.
 """
 
 from diagnostic_msgs.msg import DiagnosticStatus
 
-from ..physics import findings, findings_render
+from ..physics.analysis import findings, findings_render
 from ..ros.conversions import status
 
 LEVELS = {findings.OK: DiagnosticStatus.OK, findings.WARN: DiagnosticStatus.WARN,

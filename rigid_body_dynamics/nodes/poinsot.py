@@ -8,13 +8,13 @@ the origin to the invariant plane (along L), the invariant plane it touches at
 omega's tip, the polhode (omega's path on the ellipsoid, drawn on the current
 ellipsoid) and the herpolhode (omega's path on the plane). Lengths are omega in
 rad/s times ``scale`` (m per rad/s); traces keep the last ``trace_length``
-points. The geometry is :mod:`rigid_body_dynamics.physics.poinsot`.
+points. The geometry is :mod:`rigid_body_dynamics.physics.analysis.poinsot`.
 
 Namespace ``momentum_sphere`` (to toggle apart in RViz): the momentum sphere
 |L| = |L0| turning with the body, drawn with the radius of the ellipsoid's
 largest semi-axis, the L arrow on it, and the intersection curve with the
 energy ellipsoid that L currently runs along
-(:func:`rigid_body_dynamics.physics.momentum_sphere.current_curve`).
+(:func:`rigid_body_dynamics.physics.analysis.momentum_sphere.current_curve`).
 """
 
 from collections import deque
@@ -29,7 +29,8 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from ..physics import Inertia, momentum_sphere, poinsot, quaternions
+from ..physics import Inertia, quaternions
+from ..physics.analysis import momentum_sphere, poinsot
 from ..ros import conversions as conv
 from ..ros.parameters import ConfigurationError, Param, ParameterTable
 from ..ros.runner import run

@@ -12,8 +12,8 @@ from .environment_parameters import environment_from, environment_params
 from .sensor_parameters import sensor_params, sensors_from
 from .wheel_parameters import WHEEL_PARAMS, wheel_params, wheels_from
 from ..physics import Inertia, INTEGRATORS, presets
-from ..physics.gyrostat import GyrostatIntegrator
-from ..physics.integrators import REMOVED as REMOVED_INTEGRATORS
+from ..physics.dynamics.gyrostat import GyrostatIntegrator
+from ..physics.dynamics.integrators import REMOVED as REMOVED_INTEGRATORS
 from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
 from ..ros.state_publisher import OPTIONAL_TOPICS
 

@@ -5,11 +5,11 @@ attitude_simulator flies the wheels (all seven), attitude_analyzer counts their
 momentum (axes, inertia, friction) and attitude_controller allocates to them
 (axes, inertia, limits): the same names and meanings, so one parameters file
 (``/**:``) serves all three. :func:`wheels_from` turns a node's validated values
-into a :class:`~rigid_body_dynamics.physics.gyrostat.Wheels`, with the reason when
+into a :class:`~rigid_body_dynamics.physics.dynamics.gyrostat.Wheels`, with the reason when
 refused.
 """
 
-from ..physics.gyrostat import MAX_WHEELS, Wheels
+from ..physics.dynamics.gyrostat import MAX_WHEELS, Wheels
 from ..ros.parameters import ConfigurationError, number_list, Param
 
 

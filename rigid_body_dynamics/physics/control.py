@@ -249,18 +249,23 @@ def fly_on_wheels(moments, wheels, law, allocator, duration, control_period=0.01
     torques on the wheels, the dump torque plus the constant body ``disturbance`` (N m)
     as external torque. Returns a list of (t s, q, omega, speeds, motor torques, dump
     torque) at each control tick, and the final :class:`~.gyrostat.GyrostatIntegrator`.
+    The body steps on the one stepping core
+    (:class:`~.dynamics.plant.Plant`), as the simulator's does.
     """
-    from .gyrostat import GyrostatIntegrator
+    from .dynamics.plant import Plant
+    from .environment import Disturbances
+    from .inertia import Inertia
     every = round(control_period / dt)
     if every < 1 or abs(every * dt - control_period) > 1e-9 * control_period:
         raise ValueError(f'control_period must be a whole number of steps dt = {dt:g} s')
-    body = GyrostatIntegrator(moments, wheels, dt, q0, omega0, speeds0)
+    plant = Plant(Inertia(moments), 'exact', dt, q0, omega0,
+                  Disturbances(body=tuple(float(c) for c in disturbance)), wheels, speeds0)
+    body = plant.stepper
     records = []
     for _ in range(int(round(duration / control_period))):
         u, dump = allocator.allocate(law(body.q, body.omega), body.omega, body.speeds)
-        body.command_motors(u)
+        plant.command_motors(u)
         records.append((body.time, body.q, body.omega, body.speeds, u, dump))
-        external = tuple(a + b for a, b in zip(dump, disturbance))
         for _ in range(every):
-            body.step(external)
+            plant.step(dump)
     return records, body

@@ -12,7 +12,7 @@ offline demo read them; explicit parameters override them.
 from dataclasses import dataclass
 import math
 
-from .theory import SIDEREAL_DAY
+from .analysis.theory import SIDEREAL_DAY
 
 
 @dataclass(frozen=True)
@@ -73,8 +73,8 @@ PRESETS = {p.name: p for p in (
         name='earth_chandler',
         description='The Earth as an oblate body with (C - A)/A = 1/300 whose spin axis is '
                     '1e-6 rad off its figure axis: the free (Chandler) wobble has a period of '
-                    '300 sidereal days (seed, section 4.4). Runs at 1 step per minute, as fast '
-                    'as possible (real_time_factor 0).',
+                    '300 sidereal days (Shapiro, Classical Mechanics, section 4.4). Runs at 1 '
+                    'step per minute, as fast as possible (real_time_factor 0).',
         moments=(_EARTH_A, _EARTH_A, _EARTH_A * (1.0 + 1.0 / 300.0)),
         omega0=(_EARTH_SPIN * math.tan(_EARTH_TILT), 0.0, _EARTH_SPIN),
         integration_rate=1.0 / 60.0, publish_rate=1.0 / 600.0,

@@ -11,9 +11,10 @@ import math
 
 import numpy as np
 
-from . import equations, quaternions
+from . import quaternions
+from .dynamics import equations
+from .dynamics.plant import Plant, UserFrame
 from .inertia import as_inertia
-from .integrators import make_integrator
 
 
 @dataclass
@@ -74,7 +75,7 @@ class SimulationResult:
 
 def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
              integrator='exact', torque=None, every=1, progress=None, gyro=None,
-             torque_every=1):
+             torque_every=1, disturbances=None):
     """
     Integrate the rigid body for ``duration`` s with fixed steps ``dt`` s.
 
@@ -91,7 +92,14 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     :class:`~rigid_body_dynamics.physics.sensors.GyroModel` whose rate is a
     whole fraction of 1 / dt, read at every one of its samples from t = 0 (its
     stream is the one attitude_simulator publishes on ``imu`` with the same
-    seed and parameters). Returns a :class:`SimulationResult` including t = 0.
+    seed and parameters). ``disturbances``: a
+    :class:`~rigid_body_dynamics.physics.environment.Disturbances` (constant
+    torques, an orbit with its gravity gradient, field and residual dipole), as
+    attitude_simulator takes them from its parameters; their torque is not in
+    ``torque`` (the commanded part) but in ``work`` and ``impulse``. The run
+    steps on the one stepping core (:class:`~.dynamics.plant.Plant`), as the
+    simulator's does: the same schedule gives the same states, bit for bit.
+    Returns a :class:`SimulationResult` including t = 0.
     """
     inertia = as_inertia(inertia)
     if not (math.isfinite(duration) and duration >= 0.0):
@@ -104,9 +112,9 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
     imu_every = _imu_every(gyro, dt)
     imu = ([], [], [], [])
     q0 = np.asarray(q0, dtype=float)
-    stepper = make_integrator(integrator, inertia.moments, dt,
-                              inertia.attitude_to_principal(q0 / np.linalg.norm(q0)),
-                              inertia.to_principal(np.asarray(omega0, dtype=float)))
+    plant = Plant(inertia, integrator, dt, q0 / np.linalg.norm(q0),
+                  np.asarray(omega0, dtype=float), disturbances)
+    stepper = plant.stepper
     frame = UserFrame(inertia)
     if callable(torque):
         user_torque = torque
@@ -115,7 +123,7 @@ def simulate(inertia, omega0, q0=(0.0, 0.0, 0.0, 1.0), duration=10.0, dt=1e-3,
         principal_const = tuple(float(c) for c in inertia.to_principal(body_const))
     report_every = max(1, n // 100)
     t, q, w, tau, work, imp = [], [], [], [], [], []
-    step = stepper.step
+    step = plant.step
     for k in range(n + 1):
         if callable(torque) and (k < n or k == 0) and k % torque_every == 0:
             # (the last row repeats the last torque: no step starts there)
@@ -161,57 +169,3 @@ def _imu_every(gyro, dt):
         raise ValueError(f'the gyro rate ({gyro.rate:g} Hz) must be a whole fraction of the '
                          f'step rate 1 / dt = {1.0 / dt:g} Hz')
     return every
-
-
-class UserFrame:
-    """
-    The user's body frame against the principal frame, for one state at a time.
-
-    What :func:`simulate` does at every step of a callable torque: the state into
-    the user's frame (``state``) and the torque out of it (``torque_principal``).
-    Plain Python on tuples: numpy's per-call cost (quaternions.multiply, ``@`` on
-    3-vectors) made a body given by a full tensor cost 2.1 times one given by its
-    principal moments (benchmarks/RESULTS.md, "simulate() with a callable torque").
-    Tested against :class:`~.inertia.Inertia`'s array methods.
-    """
-
-    def __init__(self, inertia):
-        self.identity = inertia.is_principal_frame
-        self.r = tuple(tuple(row) for row in inertia.rotation.tolist())
-        x, y, z, w = (float(c) for c in inertia.quaternion)
-        self.q_conj = (-x, -y, -z, w)
-
-    def to_body(self, v):
-        """Principal-frame components (3,) -> body-frame components, a tuple."""
-        if self.identity:
-            return tuple(v)
-        (a, b, c), (d, e, f), (g, h, i) = self.r
-        x, y, z = v
-        return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
-
-    def to_principal(self, v):
-        """Body-frame components (3,) -> principal-frame components, a tuple."""
-        if self.identity:
-            return tuple(v)
-        (a, b, c), (d, e, f), (g, h, i) = self.r
-        x, y, z = v
-        return (a * x + d * y + g * z, b * x + e * y + h * z, c * x + f * y + i * z)
-
-    def attitude_to_body(self, q):
-        """Attitude of the principal frame (x, y, z, w) -> of the body frame, a tuple."""
-        return tuple(q) if self.identity else quaternions.mul_components(q, self.q_conj)
-
-    def state(self, stepper):
-        """(q (4,), omega (3,)) of a stepper in the user's body frame, as arrays."""
-        return (np.array(self.attitude_to_body(stepper.q)), np.array(self.to_body(stepper.omega)))
-
-    def torque_principal(self, torque_body, t):
-        """Return a user's body torque (3 numbers, N m) as a principal-frame tuple (ValueError)."""
-        try:
-            x, y, z = np.asarray(torque_body, dtype=float).reshape(3).tolist() \
-                if not isinstance(torque_body, tuple) else torque_body
-            values = (float(x), float(y), float(z))
-        except (TypeError, ValueError):
-            raise ValueError(f'torque(t={t!r}) must return three numbers (N m), '
-                             f'got {torque_body!r}') from None
-        return self.to_principal(values)

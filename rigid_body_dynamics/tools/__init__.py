@@ -7,5 +7,5 @@ loop), :mod:`.report` (``rigid_body_report``: figures and one HTML page, with
 running nodes into a bag) and :mod:`.analyze` (``rigid_body_analyze``: the
 analyzer's findings from a bag). Every tool runs the one analysis
 (:mod:`rigid_body_dynamics.physics.analysis`) and prints its findings with
-:mod:`rigid_body_dynamics.physics.findings_render`.
+:mod:`rigid_body_dynamics.physics.analysis.findings_render`.
 """

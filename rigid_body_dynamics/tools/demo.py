@@ -27,8 +27,8 @@ import numpy as np
 
 from ..physics import FreeRigidBody, INTEGRATORS, presets, quaternions, simulate
 from ..physics.analysis import analyse, Trajectory
+from ..physics.analysis.findings_render import text_lines
 from ..physics.control import QuaternionPD, settling_time
-from ..physics.findings_render import text_lines
 
 #: The closed-loop scene: 30 degrees about x from rest, wn 2 rad/s, zeta 0.7, 100 Hz, 10 s.
 SLEW = {'target': (math.sin(math.radians(15.0)), 0.0, 0.0, math.cos(math.radians(15.0))),
@@ -360,8 +360,8 @@ def run_closed_loop():
 
 
 def _scene_wheels():
-    """Return the wheels of the wheels scene (physics.gyrostat.Wheels)."""
-    from ..physics.gyrostat import Wheels
+    """Return the wheels of the wheels scene (physics.dynamics.gyrostat.Wheels)."""
+    from ..physics.dynamics.gyrostat import Wheels
     w = WHEEL_SCENE['wheels']
     return Wheels(w['wheel_axes'], w['wheel_inertia'], w['wheel_max_torque'],
                   w['wheel_max_speed'], w['wheel_friction_coulomb'], w['wheel_friction_viscous'])

@@ -30,10 +30,9 @@ import numpy as np
 from . import recorder, report_page
 from .. import optional
 from ..messages.bags import read_trajectory
-from ..physics import estimators, INTEGRATORS, momentum_sphere, poinsot, presets, quaternions
-from ..physics import simulate
-from ..physics.analysis import analyse, Trajectory
-from ..physics.findings_render import table_rows
+from ..physics import INTEGRATORS, presets, quaternions, simulate
+from ..physics.analysis import analyse, estimators, momentum_sphere, poinsot, Trajectory
+from ..physics.analysis.findings_render import table_rows
 from ..physics.sensors import allan_deviation, GyroErrors, GyroModel
 
 
@@ -162,7 +161,7 @@ def momentum_sphere_figure(moments, l_body, out_dir):
 
     ``moments`` principal (kg m^2), ``l_body`` (N, 3) kg m^2/s in the principal frame.
     Loops around the major axis blue, around the minor axis green, the separatrix
-    red (physics/momentum_sphere.py). Returns (png path, curves drawn).
+    red (physics/analysis/momentum_sphere.py). Returns (png path, curves drawn).
     """
     l0 = float(np.linalg.norm(l_body[0]))
     family = momentum_sphere.curve_family(moments, l0)
@@ -314,7 +313,7 @@ def _write_html(run, out_dir, figures, rows, interactive=''):
 td, th {{ padding: 2px 12px; text-align: left; }} img {{ max-width: 100%; }}</style></head>
 <body><h1>{html.escape(run.title)}</h1>
 <p>Principal moments {moments} kg m^2; {len(run)} samples over {span:.6g} s.
-Measured against theory by the one analysis (physics/analysis.py):</p>
+Measured against theory by the one analysis (physics/analysis/motion.py):</p>
 <table><tr><th>quantity</th><th>measured</th><th>theory</th></tr>
 {table}
 </table>

@@ -5,7 +5,7 @@ Made with plotly's Python package, which ships plotly.js: ``plotly.min.js`` is
 written beside index.html (no CDN, works from disk without a network). Views:
 the polhode on the inertia ellipsoid (body frame), the herpolhode on the
 invariant plane (world frame), the momentum sphere (body frame, from
-physics/momentum_sphere.py), and an animation of the body: the uniform box
+physics/analysis/momentum_sphere.py), and an animation of the body: the uniform box
 with the body's principal moments (physics.inertia.equivalent_box), its body
 axes and the omega and L arrows in the world frame, beside omega(t) with a
 marker at the frame's time, with a slider and play button.
@@ -15,7 +15,8 @@ import os
 
 import numpy as np
 
-from ..physics import estimators, momentum_sphere, poinsot, quaternions
+from ..physics import quaternions
+from ..physics.analysis import estimators, momentum_sphere, poinsot
 from ..physics.inertia import equivalent_box
 
 #: Frames of the animation (evenly spaced samples of the run).

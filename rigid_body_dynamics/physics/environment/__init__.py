@@ -10,11 +10,11 @@ gravity gradient, magnetic dipoles, magnetorquers) and :mod:`.space`
 
 from .magnetic_field import DipoleField, EARTH_RATE, IGRF13_2020, R_REF
 from .orbit import circular_elements, KeplerOrbit, lvlh_axes, lvlh_quaternion, MU_EARTH, R_EARTH
-from .space import SpaceEnvironment, Surroundings
+from .space import Disturbances, SpaceEnvironment, Surroundings
 from .sun import in_shadow, julian_date, Sun, sun_direction_almanac
 from .torque_models import GravityGradient, MagneticDipole, Magnetorquers
 
-__all__ = ['circular_elements', 'DipoleField', 'EARTH_RATE', 'GravityGradient', 'IGRF13_2020',
-           'KeplerOrbit', 'lvlh_axes', 'lvlh_quaternion', 'MagneticDipole', 'Magnetorquers',
-           'MU_EARTH', 'R_EARTH', 'R_REF', 'SpaceEnvironment', 'Sun', 'sun_direction_almanac',
-           'Surroundings', 'in_shadow', 'julian_date']
+__all__ = ['circular_elements', 'DipoleField', 'Disturbances', 'EARTH_RATE', 'GravityGradient',
+           'IGRF13_2020', 'in_shadow', 'julian_date', 'KeplerOrbit', 'lvlh_axes',
+           'lvlh_quaternion', 'MagneticDipole', 'Magnetorquers', 'MU_EARTH', 'R_EARTH', 'R_REF',
+           'SpaceEnvironment', 'Sun', 'sun_direction_almanac', 'Surroundings']

@@ -5,8 +5,15 @@ The space environment of one body: orbit, magnetic field and the torque models t
 ``field`` argument): at simulated time t it finds the position on the orbit
 and the magnetic field there, turns both into the principal frame of the body's
 attitude at that stage, and sums the torques of its models
-(:mod:`.torque_models`). It knows no model by name.
+(:mod:`.torque_models`). It knows no model by name. :class:`Disturbances` is what a body's
+environment is, as data (what the nodes' parameters say).
 """
+
+from dataclasses import dataclass
+
+from .orbit import R_EARTH
+
+_ZERO = (0.0, 0.0, 0.0)
 
 
 class Surroundings:
@@ -111,3 +118,43 @@ class SpaceEnvironment:
             a, b, c = model.torque(t, r, q, omega, env)
             tx, ty, tz = tx + a, ty + b, tz + c
         return tx, ty, tz
+
+
+@dataclass(frozen=True)
+class Disturbances:
+    """
+    The environment and its disturbance torques, summed into the commanded torque (N m).
+
+    ``body``: constant in the body frame; ``world``: constant in the world
+    frame; ``orbit``: a :class:`~rigid_body_dynamics.physics.environment.KeplerOrbit`
+    (None = no orbit); ``field``: a
+    :class:`~rigid_body_dynamics.physics.environment.DipoleField` (None = none);
+    ``gravity_gradient``: its torque on the orbit; ``residual_dipole`` (A m^2,
+    body frame): the torque m x B in the field. ``sun`` (a
+    :class:`~rigid_body_dynamics.physics.environment.Sun`, None = none) and
+    ``planet_radius`` (m) are what the sensors see (the Sun, the shadow, the
+    Earth's disc); they make no torque.
+    """
+
+    body: tuple = _ZERO
+    world: tuple = _ZERO
+    orbit: object = None
+    field: object = None
+    gravity_gradient: bool = False
+    residual_dipole: tuple = _ZERO
+    sun: object = None
+    planet_radius: float = R_EARTH
+
+    @property
+    def active(self):
+        """Whether any disturbance torque acts."""
+        return bool(any(self.body) or any(self.world) or self.gravity_gradient
+                    or any(self.residual_dipole))
+
+    def __str__(self):
+        parts = [f'{name} {value}' for name, value in (
+            ('body torque', self.body), ('world torque', self.world),
+            ('residual dipole', self.residual_dipole)) if any(value)]
+        if self.gravity_gradient:
+            parts.append('gravity gradient')
+        return ', '.join(parts) or 'none'

@@ -10,7 +10,7 @@ angular momentum in kg m^2/s. Quaternions are Hamilton, scalar-last
 
 import numpy as np
 
-from . import quaternions
+from .. import quaternions
 
 
 def euler_rhs(moments, omega, torque=(0.0, 0.0, 0.0)):

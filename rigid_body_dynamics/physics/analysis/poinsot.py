@@ -1,5 +1,7 @@
 """
-The Poinsot construction at one instant, in the world frame (seed, section 4.4.1).
+The Poinsot construction at one instant, in the world frame.
+
+Shapiro, *Classical Mechanics*, section 4.4.1.
 
 The inertia ellipsoid omega . I omega = 2T (semi-axes sqrt(2T / I_i) along the
 principal axes, rad/s) is fixed in the body; omega's tip lies on it and on the
@@ -13,7 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import equations, quaternions
+from .. import quaternions
+from ..dynamics import equations
 
 
 @dataclass(frozen=True)

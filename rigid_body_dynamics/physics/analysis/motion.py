@@ -3,7 +3,8 @@ The one analysis of an attitude trajectory: what the motion does, and whether ph
 
 This module computes; the findings' data model is :mod:`.findings`, what counts
 as agreement :mod:`.tolerances`, and their text, table and diagnostics forms
-:mod:`.findings_render` (their names are re-exported here).
+:mod:`.findings_render` (the package :mod:`rigid_body_dynamics.physics.analysis`
+re-exports their names and this module's).
 
 Every door uses it: the ``attitude_analyzer`` node (live topics), the report,
 the demo and ``rigid_body_analyze`` (bags). A :class:`Trajectory` holds the
@@ -24,16 +25,19 @@ import math
 
 import numpy as np
 
-from . import equations, estimators, quaternions, theory
-from .environment.libration import jacobi_integral, libration_modes, oscillation_frequencies
+from . import estimators, theory
 from .findings import (ConservationFindings, ERROR, EstimationFindings, Findings, OK,
                        OrbitFindings, PrecessionFindings, Quantity, StabilityFindings,
                        UNAVAILABLE, WARN)
 from .findings_render import quantity_lines
-from .inertia import as_inertia
 from .tolerances import compare, level, Tolerances, unavailable, worst
+from .. import quaternions
+from ..dynamics import equations
+from ..environment.libration import jacobi_integral, libration_modes, oscillation_frequencies
+from ..inertia import as_inertia
 
-__all__ = ['analyse', 'compare', 'ConservationFindings', 'ERROR', 'Findings', 'OK',
+__all__ = ['analyse', 'autocorrelation_time', 'compare', 'ConservationFindings', 'ERROR',
+           'estimation', 'EstimationFindings', 'Findings', 'OK', 'OrbitFindings',
            'PrecessionFindings', 'Quantity', 'quantity_lines', 'StabilityFindings', 'Tolerances',
            'Trajectory', 'UNAVAILABLE', 'unavailable', 'WARN']
 
@@ -315,7 +319,7 @@ def _gyrostat(trajectory, t, w, under_torque, tol):
     about the axis the motion stays nearest, with h along it (:func:`~.gyrostat.spin_stability`;
     the growth rate is the theory's, not measured yet).
     """
-    from .gyrostat import precession_rate, spin_stability
+    from ..dynamics.gyrostat import precession_rate, spin_stability
     if under_torque or np.any(trajectory.motor_torques != 0.0):
         why = ("motor or external torque in the window: the torque-free gyrostat's theory "
                'does not apply')

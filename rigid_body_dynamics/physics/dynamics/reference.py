@@ -55,7 +55,7 @@ def gyrostat_rhs(moments, wheels, motors, torque=(0.0, 0.0, 0.0),
     ``torque_world`` world external torques (N m), all held.
     """
     from .gyrostat import FRICTION_SMOOTHING
-    from .quaternions import rotate_components
+    from ..quaternions import rotate_components
     inertia = np.diag(np.asarray(moments, dtype=float))
     g = np.array(wheels.axes, dtype=float).reshape(-1, 3)
     j = np.array(wheels.inertia, dtype=float)
