@@ -27,7 +27,15 @@ STANDARD = {
     | {'~/get_type_description': 'type_description_interfaces/srv/GetTypeDescription'},
 }
 
-HEADINGS = {'sub': 'Subscribed topics', 'pub': 'Published topics', 'srv': 'Services'}
+HEADINGS = {'sub': 'Subscribed topics', 'pub': 'Published topics', 'srv': 'Services',
+            'action': 'Actions'}
+
+#: What an action server puts on the graph under ``<name>/_action/``: kind, name, type
+#: (``{}`` is the action's type).
+ACTION_ENDPOINTS = (('srv', 'send_goal', '{}_SendGoal'), ('srv', 'get_result', '{}_GetResult'),
+                    ('srv', 'cancel_goal', 'action_msgs/srv/CancelGoal'),
+                    ('pub', 'feedback', '{}_FeedbackMessage'),
+                    ('pub', 'status', 'action_msgs/msg/GoalStatusArray'))
 
 #: The QoS of a topic, as the node pages write it: reliability, durability, history depth.
 STATE = 'reliable, volatile, 10'
@@ -40,7 +48,7 @@ LATCHED = 'reliable, transient local, 1'
 class Interface:
     """One topic or service of a node."""
 
-    kind: str          # 'pub', 'sub' or 'srv'
+    kind: str          # 'pub', 'sub', 'srv' or 'action'
     name: str          # as the node creates it: relative, ~/private or /absolute
     type: str          # e.g. 'nav_msgs/msg/Odometry'  # noqa: A003 (a field name)
     text: str          # what it carries: units, frame, QoS
@@ -58,21 +66,28 @@ class Interfaces:
 
     def qos_of(self, item):
         """Return a topic's QoS text (``reliability, durability, depth``); '' for a service."""
-        return '' if item.kind == 'srv' else self.qos.get(item.name, STATE)
+        return '' if item.kind in ('srv', 'action') else self.qos.get(item.name, STATE)
 
     def resolved(self, namespace='/', present=lambda when: True):
         """
         Return {kind: {full name: type}} in ``namespace``, standard interfaces included.
 
-        ``present(when)`` says whether a conditional item exists in the run at hand.
+        ``present(when)`` says whether a conditional item exists in the run at hand. An
+        action is its services and topics (:data:`ACTION_ENDPOINTS`).
         """
-        out = {kind: {} for kind in HEADINGS}
+        out = {kind: {} for kind in HEADINGS if kind != 'action'}
         base = namespace.rstrip('/')
         for kind, names in STANDARD.items():
             for name, msg_type in names.items():
                 out[kind][self._full(name, base)] = msg_type
         for item in self.items:
-            if not item.when or present(item.when):
+            if item.when and not present(item.when):
+                continue
+            if item.kind == 'action':
+                for kind, part, msg_type in ACTION_ENDPOINTS:
+                    out[kind][self._full(f'{item.name}/_action/{part}', base)] = \
+                        msg_type.format(item.type)
+            else:
                 out[item.kind][self._full(item.name, base)] = item.type
         return out
 
@@ -92,13 +107,13 @@ class Interfaces:
             if not items:
                 lines += ['None.', '']
                 continue
-            if kind == 'srv':
+            if kind in ('srv', 'action'):
                 lines += ['| name | type | meaning | exists |', '| --- | --- | --- | --- |']
             else:
                 lines += ['| name | type | meaning | QoS | exists |',
                           '| --- | --- | --- | --- | --- |']
             for i in items:
-                qos = '' if kind == 'srv' else f' {self.qos_of(i)} |'
+                qos = '' if kind in ('srv', 'action') else f' {self.qos_of(i)} |'
                 lines.append(f'| `{i.name}` | `{i.type}` | {i.text} |{qos} '
                              f'{i.when or "always"} |')
             lines.append('')
@@ -111,6 +126,9 @@ class Interfaces:
                   '`~/set_parameters`, ...) and `~/get_type_description`.', '']
         return '\n'.join(lines)
 
+
+#: When the standard simulator interface exists.
+SIM_IF = 'if simulation_interfaces is importable (always on a ROS install)'
 
 SIMULATOR = Interfaces('attitude_simulator', [
     Interface('sub', 'torque_cmd', 'geometry_msgs/msg/WrenchStamped',
@@ -191,6 +209,34 @@ SIMULATOR = Interfaces('attitude_simulator', [
               'Back to the initial state; simulated time restarts at 0, the command is cleared.'),
     Interface('srv', '~/pause', 'std_srvs/srv/SetBool',
               '`true` freezes the state (nothing published), `false` resumes.'),
+    # ROS 2's standard simulator interface ({doc}`../../howto/simulation_interfaces`)
+    Interface('srv', 'get_simulator_features', 'simulation_interfaces/srv/GetSimulatorFeatures',
+              'What of the standard interface this simulator does (states, resets by time and '
+              'state, stepping, entity state).', SIM_IF),
+    Interface('srv', 'get_simulation_state', 'simulation_interfaces/srv/GetSimulationState',
+              'STOPPED (paused at time 0 and the initial state), PLAYING or PAUSED.', SIM_IF),
+    Interface('srv', 'set_simulation_state', 'simulation_interfaces/srv/SetSimulationState',
+              'Stop, play or pause; the target state again is ALREADY_IN_TARGET_STATE.',
+              SIM_IF),
+    Interface('srv', 'reset_simulation', 'simulation_interfaces/srv/ResetSimulation',
+              'SCOPE_TIME (the state now at time 0), SCOPE_STATE (the initial state now), both, '
+              'or SCOPE_ALL (as `~/reset`); playing or paused stays.', SIM_IF),
+    Interface('srv', 'step_simulation', 'simulation_interfaces/srv/StepSimulation',
+              'While paused or stopped: exactly `steps` integration steps (1 / '
+              '`integration_rate` s each), published as they go; while playing '
+              'RESULT_OPERATION_FAILED.', SIM_IF),
+    Interface('srv', 'get_entities', 'simulation_interfaces/srv/GetEntities',
+              'The one entity, the body, named by its body frame (with `frame_prefix`); the '
+              'name filter is a regular expression.', SIM_IF),
+    Interface('srv', 'get_entity_state', 'simulation_interfaces/srv/GetEntityState',
+              'Attitude (and with an orbit the position), angular (and orbital) velocity and '
+              'acceleration in `world_frame`, stamped with the simulated time.', SIM_IF),
+    Interface('srv', 'set_entity_state', 'simulation_interfaces/srv/SetEntityState',
+              'Sets the attitude and the angular velocity (world frame); an invalid quaternion '
+              'is INVALID_POSE.', SIM_IF),
+    Interface('action', 'simulate_steps', 'simulation_interfaces/action/SimulateSteps',
+              'As `step_simulation`, with feedback after every step; a cancel stops between '
+              'steps.', SIM_IF),
 ], qos={'torque_cmd': COMMANDS, 'wheel_cmd': COMMANDS, 'magnetorquer_cmd': COMMANDS,
         'inertia': LATCHED, '/clock': 'best effort, volatile, 1',
         '/tf': 'reliable, volatile, 100'})

@@ -48,6 +48,7 @@ from .simulator_diagnostics import SimulatorReport
 from .simulator_parameters import PARAMETERS, state_topics
 from ..engine import BodySimulation, Lockstep, Loop, Member, Pace
 from ..physics import presets
+from ..ros import simulator_interface
 from ..ros.command_decoder import decode_dipoles, decode_wheels, steady_times, TorqueDecoder
 from ..ros.intake import Intake
 from ..ros.runner import run
@@ -250,6 +251,12 @@ class AttitudeSimulator(Node):
         self._commands = tuple(self._decoders)
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
+        self.simulator_interface = None
+        if simulator_interface.available():
+            self.simulator_interface = simulator_interface.SimulatorInterface(
+                self, self.body, self.pace, self.state.publish, self._frames, self.get_logger())
+        else:
+            simulator_interface.say_unavailable(self.get_logger())
 
     # ------------------------------------------------------------------ torque
     def _inbox(self):
@@ -319,6 +326,9 @@ class AttitudeSimulator(Node):
         if getattr(self, '_intake', None) is not None:
             self._intake.destroy()
             self._intake = None
+        if getattr(self, 'simulator_interface', None) is not None:
+            self.simulator_interface.destroy()
+            self.simulator_interface = None
         super().destroy_node()
 
     # ------------------------------------------------------------------ stepping
