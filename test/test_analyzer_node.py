@@ -250,7 +250,20 @@ def test_dropped_duplicated_reordered_and_time_reset(launch, probe, rng):
     assert float(values['body rate error (rel.)']) < 1e-9
     level, message, values = probe.newest_status('attitude_analyzer: conservation')
     assert level == DiagnosticStatus.OK
+    # ~/reset_baseline: drift is measured again from a sample after the newest one heard
+    before = float(values['baseline stamp (s)'])
+    assert before < 1.0
     assert probe.call(Trigger, '/attitude_analyzer/reset_baseline', Trigger.Request()).success
+    _publish_states(probe, pub, np.arange(6.0, 8.0, 0.01), body2)
+    level, message, values = wait_status(
+        probe, 'conservation', lambda v: is_number(v.get('baseline stamp (s)', '')) and
+        float(v['baseline stamp (s)']) >= 5.99, 20.0, 'the baseline to move past the reset')
+    assert level == DiagnosticStatus.OK
+    assert float(values['energy drift since baseline (rel.)']) < 1e-14
+    # and the input goes STALE when odom stops (stale_timeout 1 s)
+    probe.spin_until(lambda: probe.newest_status('attitude_analyzer: input')[0] ==
+                     DiagnosticStatus.STALE, 10.0, 'the input to go stale')
+    assert 'no odom for' in probe.newest_status('attitude_analyzer: input')[1]
     stop_cleanly(analyzer)
 
 

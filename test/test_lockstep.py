@@ -222,3 +222,45 @@ def test_the_controller_takes_best_effort_odometry_when_told(launch, probe):
     probe.handshake(odom, odom_msg(0.01, (0.0, 0.0, 0.0, 1.0), (0.1, 0.0, 0.0)),
                     lambda: bool(answers))
     assert answers[0].wrench.torque.x < 0.0          # the target is rest: it brakes omega_x
+
+
+def test_the_controller_drops_hostile_odometry_and_exits_zero(launch, probe):
+    """A NaN rate or a zero quaternion is not answered (warned, counted); SIGINT exits 0."""
+    from geometry_msgs.msg import InertiaStamped, WrenchStamped
+    from ros_harness import LATCHED, odom_msg
+    ctl = launch('rigid_body_dynamics.nodes.controller', '-p', 'control_rate:=0.0', name='ctl')
+    answers = probe.subscribe(WrenchStamped, 'torque_cmd')
+    inertia = probe.node.create_publisher(InertiaStamped, 'inertia', LATCHED)
+    msg = InertiaStamped()
+    msg.inertia.ixx, msg.inertia.iyy, msg.inertia.izz = 1.0, 2.0, 3.0
+    inertia.publish(msg)
+    odom = probe.publisher(Odometry, 'odom')
+    probe.handshake(odom, odom_msg(0.01, (0.0, 0.0, 0.0, 1.0), (0.1, 0.0, 0.0)),
+                    lambda: bool(answers))
+    n = len(answers)
+    # (each alone: the controller answers the newest of the states pending together)
+    odom.publish(odom_msg(0.02, (0.0, 0.0, 0.0, 1.0), (float('nan'), 0.0, 0.0)))
+    probe.spin_until(lambda: 'odom with a non-finite value dropped (1 so far)' in ctl.output(),
+                     10.0, 'the NaN state dropped')
+    odom.publish(odom_msg(0.03, (0.0, 0.0, 0.0, 0.0), (0.1, 0.0, 0.0)))
+    probe.spin_until(lambda: 'odom with a zero quaternion dropped (2 so far)' in ctl.output(),
+                     10.0, 'the zero quaternion dropped')
+    assert len(answers) == n                         # neither was answered
+    odom.publish(odom_msg(0.04, (0.0, 0.0, 0.0, 1.0), (0.2, 0.0, 0.0)))
+    probe.spin_until(lambda: len(answers) > n, 10.0, 'the next good state answered')
+    a = answers[-1]
+    assert a.header.stamp.nanosec == 40_000_000 and a.wrench.torque.x < answers[0].wrench.torque.x
+    code, _ = ctl.stop()
+    assert code == 0 and 'Traceback' not in ctl.output()
+
+
+@pytest.mark.parametrize('args, reason', [
+    (('-p', 'target_orientation:=[0.0, 0.0, 0.0, 0.0]'),
+     'target_orientation must not be the zero quaternion'),
+    (('-p', 'natural_frequency:=-1.0'), 'natural_frequency'),
+    (('-p', 'mode:=spin'), 'mode'),
+])
+def test_bad_controller_parameters_are_refused_with_the_reason(launch, args, reason):
+    proc = launch('rigid_body_dynamics.nodes.controller', *args, name='bad_controller')
+    assert proc.wait(30.0) == 1
+    assert reason in proc.output() and 'Traceback' not in proc.output()

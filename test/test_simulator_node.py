@@ -554,3 +554,49 @@ def test_state_topics_leaves_out_what_is_not_asked_for(launch, probe):
     bad = launch(SIM, '-p', 'state_topics:=odom,angular_speed', name='sim_bad_topics')
     assert bad.wait(30.0) == 1
     assert 'state_topics: unknown topic(s) odom, angular_speed' in bad.output()
+
+
+def test_frames_initial_orientation_and_no_tf_as_configured(launch, probe):
+    """world_frame, body_frame, initial_orientation (normalised) and publish_tf:=false act."""
+    q0 = [0.0, 0.0, 2.0 * math.sin(0.3), 2.0 * math.cos(0.3)]     # not unit: normalised
+    launch(SIM, '-p', 'publish_clock:=true', '-p', 'world_frame:=earth', '-p',
+           'body_frame:=sat', '-p', f'initial_orientation:={q0}', '-p', 'publish_tf:=false',
+           '-p', 'initial_angular_velocity:=[0.0, 0.0, 0.0]', name='sim')
+    odom = probe.subscribe(Odometry, 'odom')
+    probe.wait_for('odom', 3)
+    m = odom[-1]
+    assert m.header.frame_id == 'earth' and m.child_frame_id == 'sat'
+    # at rest and free the attitude stays the initial one, normalised
+    unit = np.array(q0) / 2.0
+    assert quaternions.angle_between(quaternion_array(m.pose.pose.orientation), unit) < 1e-15
+    # no /tf from this node, and a command in its body frame is taken, one in another refused
+    probe.spin_until(lambda: probe.endpoints('pub', 'attitude_simulator'), 10.0, 'the node')
+    assert '/tf' not in probe.endpoints('pub', 'attitude_simulator')
+    applied = probe.subscribe(WrenchStamped, 'applied_torque')
+    pub = probe.publisher(WrenchStamped, 'torque_cmd')
+    command = WrenchStamped()
+    command.header.frame_id = 'sat'
+    command.wrench.torque.x = 0.1
+    probe.handshake(pub, command, lambda: applied and applied[-1].wrench.torque.x == 0.1)
+    assert applied[-1].header.frame_id == 'sat'
+    command.header.frame_id = 'base_link'
+    pub.publish(command)
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    probe.spin_until(lambda: status_count(probe, 'torque command', 'rejected_frame') >= 1,
+                     10.0, 'the base_link command refused')
+
+
+def test_max_torque_changed_at_run_time_clips_the_next_command(launch, probe):
+    """A max_torque of 0.05 set at run time: a 1 N m command acts as 0.05, counted."""
+    launch(SIM, '-p', 'publish_clock:=true', name='sim')
+    assert set_params(probe, max_torque=0.05)[0].successful
+    applied = probe.subscribe(WrenchStamped, 'applied_torque')
+    pub = probe.publisher(WrenchStamped, 'torque_cmd')
+    command = WrenchStamped()
+    command.wrench.torque.z, command.wrench.torque.x = 1.0, -0.02
+    probe.handshake(pub, command, lambda: applied and applied[-1].wrench.torque.z != 0.0)
+    torque = applied[-1].wrench.torque
+    assert (torque.x, torque.y, torque.z) == (-0.02, 0.0, 0.05)
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    probe.spin_until(lambda: status_count(probe, 'torque command', 'clipped') >= 1, 10.0,
+                     'the clipping counted')

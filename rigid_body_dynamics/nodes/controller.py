@@ -52,6 +52,7 @@ from ..ros.intake import Intake
 from ..ros.parameters import as_vector, ConfigurationError, Param, ParameterTable
 from ..ros.runner import run
 from ..ros.state_publisher import LATCHED_QOS, STATE_QOS
+from ..ros.throttle import ThrottledWarnings
 
 NODE_NAME = 'attitude_controller'
 #: Longest wait (s) for the wheel_state of an odom's stamp (both come from one tick).
@@ -142,6 +143,8 @@ class AttitudeController(Node):
         self._next_due_ns = None
         self._last_ns = None
         self.answered = 0
+        self.dropped = 0                           # inputs with a non-finite number
+        self._warnings = ThrottledWarnings(self.get_logger())
         self._bdot = self._values['mode'] == 'bdot'
         if self._bdot:
             self._pub_dipole = self.create_publisher(Vector3Stamped, 'magnetorquer_cmd',
@@ -269,6 +272,9 @@ class AttitudeController(Node):
         Every reading goes through the law (its dB/dt needs each); one is answered when
         due at ``control_rate``, as states are.
         """
+        b = msg.magnetic_field
+        if self._hostile((b.x, b.y, b.z), 'magnetic_field'):
+            return
         stamp = conv.time_ns(msg.header.stamp)
         with self._lock:
             law = self._law
@@ -302,6 +308,23 @@ class AttitudeController(Node):
             self._intake.wait('wheel_state', 0.05)
             waited += 0.05
 
+    def _hostile(self, numbers, topic, quaternion=None):
+        """
+        Count and warn of (throttled per kind) an input not to answer; True if it is one.
+
+        One with a non-finite number, or whose ``quaternion`` (4 numbers) is zero.
+        """
+        if not all(math.isfinite(x) for x in numbers):
+            what = 'a non-finite value'
+        elif quaternion is not None and not any(quaternion):
+            what = 'a zero quaternion'
+        else:
+            return False
+        self.dropped += 1
+        self._warnings.warn(f'{topic}: {what}', f'{topic} with {what} dropped ({self.dropped} '
+                            'so far); the last command stays in force', 5.0)
+        return True
+
     def answer(self, odom, speeds=None):
         """
         Answer one state if it is due (the newest pending one): publish the command.
@@ -309,6 +332,9 @@ class AttitudeController(Node):
         With wheels (``speeds``: their speeds at the state's stamp, rad/s) the dump
         torque on torque_cmd first, then the motor torques on wheel_cmd.
         """
+        o, w = odom.pose.pose.orientation, odom.twist.twist.angular
+        if self._hostile((o.x, o.y, o.z, o.w, w.x, w.y, w.z), 'odom', (o.x, o.y, o.z, o.w)):
+            return
         stamp = conv.time_ns(odom.header.stamp)
         with self._lock:
             law = self._law
@@ -319,7 +345,6 @@ class AttitudeController(Node):
             if law is None or (self._next_due_ns is not None and stamp < self._next_due_ns):
                 return
             self._next_due_ns = stamp + (round(1e9 / rate) if rate > 0.0 else 1)
-        o, w = odom.pose.pose.orientation, odom.twist.twist.angular
         tau = law((o.x, o.y, o.z, o.w), (w.x, w.y, w.z))
         motors = None
         if self._allocator is not None:
