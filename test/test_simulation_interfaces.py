@@ -222,8 +222,9 @@ def test_in_orbit_the_entity_state_carries_the_orbit(launch, probe):
 
 
 def test_each_fleet_body_answers_for_itself(launch, probe):
-    """attitude_fleet: every body has the services in its namespace; one stepped, one playing."""
-    launch('rigid_body_dynamics.nodes.fleet', '--', '--bodies', '2', name='fleet')
+    """attitude_fleet, told so: each body has the services in its namespace and its own state."""
+    launch('rigid_body_dynamics.nodes.fleet', '-p', 'simulation_interfaces:=true', '--',
+           '--bodies', '2', name='fleet')
     assert call(probe, 'get_entities', None, '/body2').entities == ['body2/base_link']
     assert set_state(probe, SimulationState.STATE_STOPPED, '/body1') == OK
     assert call(probe, 'step_simulation', sim_srv.StepSimulation.Request(steps=100),

@@ -11,6 +11,8 @@ number). Each body's frame ids carry its name (``frame_prefix`` ``<name>/``: bod
 body1/base_link), so every body broadcasts a TF tree of its own; bodies that still share
 frames (a ``frame_prefix`` given to all) do not broadcast /tf. One body at most publishes
 /clock; an as-fast-as-possible body makes the others late (run it in its own process).
+ROS 2's standard simulator services (``simulation_interfaces``) are off unless set, for a
+body or for all: their endpoints made 128 bodies start and exit 2.5-3 times slower.
 
 ``attitude_fleet [--bodies N] [--prefix body] [--names a,b,...] [--ros-args ...]``
 """
@@ -70,6 +72,7 @@ class Fleet:
                     self._contexts.append(context)
                     kwargs['context'] = context
                 self.nodes.append(AttitudeSimulator(frame_prefix_default=name + '/',
+                                                    simulation_interfaces_default=False,
                                                     namespace='/' + name, **kwargs))
             clocks = [n.get_namespace() for n in self.nodes if n.publishes_clock]
             if len(clocks) > 1:

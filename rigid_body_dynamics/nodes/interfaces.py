@@ -58,9 +58,11 @@ class Interface:
 class Interfaces:
     """The topics and services of the node ``node`` (its default name)."""
 
-    def __init__(self, node, items, qos=None):
+    def __init__(self, node, items, qos=None, intake=False):
         self.node = node
         self.items = tuple(items)
+        #: whether its subscriptions are on the hidden helper node ``_<node>_intake``
+        self.intake = intake
         #: topic name -> QoS (reliability, durability, depth); the rest are STATE
         self.qos = dict(qos or {})
 
@@ -98,6 +100,40 @@ class Interfaces:
             return f'{base}/{self.node}/{name[2:]}'
         return f'{base}/{name}'
 
+    def graph_markdown(self):
+        """
+        Return what ``ros2 node / topic / service / action list`` show of this node.
+
+        In the default namespace, every conditional item present, the standard
+        interfaces of every node left out; names with a part that starts with ``_``
+        are hidden, which ``-a`` / ``--include-hidden-...`` shows.
+        """
+        want = self.resolved('/')
+        standard = {kind: {self._full(n, '') for n in names} for kind, names in STANDARD.items()}
+        topics = {name: t for kind in ('pub', 'sub') for name, t in want[kind].items()
+                  if name not in standard.get(kind, ())}
+        services = {n: t for n, t in want['srv'].items() if n not in standard['srv']}
+        actions = {self._full(i.name, ''): i.type for i in self.items if i.kind == 'action'}
+        hidden = [f'/_{self.node}_intake'] if self.intake else []
+        lines = ['## On the ROS graph', '',
+                 'What the ROS 2 command line lists for this node alone, in the default '
+                 'namespace, with every optional topic on (the parameter services, '
+                 '`/rosout` and `/parameter_events` left out). A name with a part that '
+                 'starts with `_` is hidden: `-a` (nodes) and `--include-hidden-topics` / '
+                 '`--include-hidden-services` show it.', '', '```text',
+                 '$ ros2 node list -a']
+        lines += [f'{name}    # hidden: the subscriptions it takes in batches'
+                  for name in hidden] + [f'/{self.node}']
+        lines += ['$ ros2 topic list -t --include-hidden-topics']
+        lines += [f'{name} [{t}]' for name, t in sorted(topics.items())]
+        if services:
+            lines += ['$ ros2 service list -t --include-hidden-services']
+            lines += [f'{name} [{t}]' for name, t in sorted(services.items())]
+        if actions:
+            lines += ['$ ros2 action list -t']
+            lines += [f'{name} [{t}]' for name, t in sorted(actions.items())]
+        return '\n'.join(lines + ['```', ''])
+
     def markdown(self):
         """Return the node page's topic and service sections (Markdown; headings at level 2)."""
         lines = []
@@ -128,7 +164,8 @@ class Interfaces:
 
 
 #: When the standard simulator interface exists.
-SIM_IF = 'if simulation_interfaces is importable (always on a ROS install)'
+SIM_IF = ('if `simulation_interfaces` (the parameter; attitude_fleet: off by default) and the '
+          'package is importable (always on a ROS install)')
 
 SIMULATOR = Interfaces('attitude_simulator', [
     Interface('sub', 'torque_cmd', 'geometry_msgs/msg/WrenchStamped',
@@ -239,7 +276,7 @@ SIMULATOR = Interfaces('attitude_simulator', [
               'steps.', SIM_IF),
 ], qos={'torque_cmd': COMMANDS, 'wheel_cmd': COMMANDS, 'magnetorquer_cmd': COMMANDS,
         'inertia': LATCHED, '/clock': 'best effort, volatile, 1',
-        '/tf': 'reliable, volatile, 100'})
+        '/tf': 'reliable, volatile, 100'}, intake=True)
 
 ANALYZER = Interfaces('attitude_analyzer', [
     Interface('sub', 'odom', 'nav_msgs/msg/Odometry',
@@ -279,7 +316,7 @@ ANALYZER = Interfaces('attitude_analyzer', [
               'Measure drift from the next sample on.'),
 ], qos={name: INPUT for name in (
     'odom', 'applied_torque', 'wheel_state', 'attitude_estimate', 'attitude_simulator/imu_bias',
-    'attitude_estimator/gyro_bias_estimate')} | {'inertia': LATCHED})
+    'attitude_estimator/gyro_bias_estimate')} | {'inertia': LATCHED}, intake=True)
 
 POINSOT = Interfaces('poinsot_visualizer', [
     Interface('sub', 'odom', 'nav_msgs/msg/Odometry', 'The motion to draw; best effort.'),
@@ -313,7 +350,7 @@ CONTROLLER = Interfaces('attitude_controller', [
     Interface('pub', 'wheel_cmd', 'std_msgs/msg/Float64MultiArray',
               "Motor torques (N m, one per wheel) flying the law's torque.",
               'if `actuator` is wheels'),
-], qos={'inertia': LATCHED})
+], qos={'inertia': LATCHED}, intake=True)
 
 ESTIMATOR = Interfaces('attitude_estimator', [
     Interface('sub', 'imu', 'sensor_msgs/msg/Imu',

@@ -114,9 +114,11 @@ class AttitudeSimulator(Node):
     every body's :meth:`member` on one Loop instead.
     """
 
-    def __init__(self, frame_prefix_default='', **kwargs):
-        # the default of frame_prefix (attitude_fleet gives each body its name)
+    def __init__(self, frame_prefix_default='', simulation_interfaces_default=True, **kwargs):
+        # the defaults attitude_fleet changes: frame_prefix (each body's name) and
+        # simulation_interfaces (off: their endpoints cost a large fleet its start and exit)
         self.frame_prefix_default = frame_prefix_default
+        self.simulation_interfaces_default = simulation_interfaces_default
         super().__init__(NODE_NAME, **kwargs)
         self._stop = threading.Event()
         self._thread = None
@@ -252,7 +254,9 @@ class AttitudeSimulator(Node):
         self.create_service(Trigger, '~/reset', self._on_reset)
         self.create_service(SetBool, '~/pause', self._on_pause)
         self.simulator_interface = None
-        if simulator_interface.available():
+        if not self.get_parameter('simulation_interfaces').value:
+            pass
+        elif simulator_interface.available():
             self.simulator_interface = simulator_interface.SimulatorInterface(
                 self, self.body, self.pace, self.state.publish, self._frames, self.get_logger())
         else:
