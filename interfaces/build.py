@@ -25,6 +25,8 @@ import sys
 import time
 
 HERE = Path(__file__).resolve().parent
+#: The mend of the registry wheels' imported targets every package here includes.
+MEND = HERE / 'registry_wheels.cmake'
 
 
 class BuildError(RuntimeError):
@@ -32,8 +34,8 @@ class BuildError(RuntimeError):
 
 
 def source_key(source):
-    """Return a short hash of every file under ``source`` (path and bytes)."""
-    digest = hashlib.sha256()
+    """Return a short hash of every file under ``source`` (path and bytes) and of MEND."""
+    digest = hashlib.sha256(MEND.read_bytes())
     for path in sorted(Path(source).rglob('*')):
         if path.is_file():
             digest.update(path.relative_to(source).as_posix().encode() + path.read_bytes())

@@ -140,6 +140,14 @@ def test_the_simulation_state_machine_and_exact_stepping(launch, probe):
     assert status == GoalStatus.STATUS_ABORTED and result.result.result == FAILED
     assert feedback == []
     probe.spin_until(lambda: entity(probe)[0] > 1_900_000_000, 20.0, 'time to move on')
+    # stopped, then resumed and paused again by ~/pause: paused, no longer stopped
+    from std_srvs.srv import SetBool
+    assert set_state(probe, s.STATE_STOPPED) == OK
+    pause = '/attitude_simulator/pause'
+    assert probe.call(SetBool, pause, SetBool.Request(data=False)).success
+    probe.spin_until(lambda: entity(probe)[0] > 0, 20.0, 'time to move after ~/pause')
+    assert probe.call(SetBool, pause, SetBool.Request(data=True)).success
+    assert state_of(probe) == s.STATE_PAUSED
 
 
 def test_resets_by_scope_and_setting_the_entity_state(launch, probe):

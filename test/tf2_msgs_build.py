@@ -10,30 +10,25 @@ names and types, so it equals Jazzy's, which :func:`build` checks. Built once
 per venv and source version, under ``<venv>/tf2_msgs-build/<key>`` (about 10 s).
 """
 
-import hashlib
+import importlib.util
 import json
 import os
 from pathlib import Path
 import shutil
-import subprocess
 import sys
-import time
 
 SOURCE = Path(__file__).resolve().parent / 'interfaces' / 'tf2_msgs'
 #: Jazzy's type hash of tf2_msgs/msg/TFMessage (tf2_msgs 0.36, the ROS install's).
 JAZZY_TYPE_HASH = 'RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087'
 
-
-class BuildError(RuntimeError):
-    """The interface package could not be built here; the message says why."""
-
-
-def _key():
-    digest = hashlib.sha256()
-    for path in sorted(SOURCE.rglob('*')):
-        if path.is_file():
-            digest.update(path.relative_to(SOURCE).as_posix().encode() + path.read_bytes())
-    return digest.hexdigest()[:16]
+# interfaces/build.py, the repo's builder of interface packages (by path: "build" is a
+# common module name)
+_spec = importlib.util.spec_from_file_location(
+    'rbd_interface_build', Path(__file__).resolve().parents[1] / 'interfaces' / 'build.py')
+interface_build = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(interface_build)
+#: The package could not be built here; the message says why.
+BuildError = interface_build.BuildError
 
 
 def environment(prefix):
@@ -62,34 +57,19 @@ def build(venv=sys.prefix, log=print):
     Raises BuildError with the reason (a missing tool, the end of the build
     log, a type hash that differs from Jazzy's).
     """
-    venv = Path(venv)
-    root = venv / 'tf2_msgs-build' / _key()
+    venv = Path(venv).resolve()
+    root = venv / 'tf2_msgs-build' / interface_build.source_key(SOURCE)
     prefix = root / 'install' / 'tf2_msgs'
     if (root / 'done').exists():
         return prefix
-    colcon = venv / 'bin' / 'colcon'
-    for tool in (str(colcon), 'cmake', 'c++'):
-        if shutil.which(tool) is None:
-            raise BuildError(f'cannot build tf2_msgs: {tool} not found')
     shutil.rmtree(root, ignore_errors=True)
     root.mkdir(parents=True)
-    env = dict(os.environ, PATH=os.pathsep.join((str(venv / 'bin'), os.environ['PATH'])),
-               CMAKE_PREFIX_PATH=str(venv), AMENT_PREFIX_PATH=str(venv),
-               PYTHONWARNINGS='ignore')
-    t0 = time.monotonic()
-    result = subprocess.run(
-        [str(colcon), '--log-base', str(root / 'log'), 'build', '--base-paths', str(SOURCE),
-         '--build-base', str(root / 'build'), '--install-base', str(root / 'install'),
-         '--event-handlers', 'console_direct-'],
-        cwd=root, env=env, capture_output=True, text=True, timeout=600)
-    if result.returncode != 0:
-        tail = '\n'.join((result.stdout + result.stderr).splitlines()[-25:])
-        raise BuildError(f'colcon build of tf2_msgs failed ({result.returncode}):\n{tail}')
+    seconds = interface_build.colcon_build(SOURCE, root, venv, root / 'install')
     found = type_hash(prefix)
     if found != JAZZY_TYPE_HASH:
         raise BuildError(f'built TFMessage has type hash {found}, Jazzy has {JAZZY_TYPE_HASH}')
-    (root / 'done').write_text(f'{time.monotonic() - t0:.1f} s\n')
-    log(f'tf2_msgs interface built in {time.monotonic() - t0:.1f} s under {root}')
+    (root / 'done').write_text(f'{seconds:.1f} s\n')
+    log(f'tf2_msgs interface built in {seconds:.1f} s under {root}')
     return prefix
 
 

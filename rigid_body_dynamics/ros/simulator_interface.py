@@ -128,11 +128,16 @@ class SimulatorInterface:
             self.publish(item)
 
     def state_code(self):
-        """Return the SimulationState code now: STOPPED, PAUSED or PLAYING."""
+        """
+        Return the SimulationState code now: STOPPED, PAUSED or PLAYING.
+
+        STOPPED needs the stop to be the last word: paused, and still at step 0 (``~/pause``
+        may have resumed and paused it since).
+        """
         s = sim_msg.SimulationState
         if not self.body.paused:
             return s.STATE_PLAYING
-        return s.STATE_STOPPED if self.stopped else s.STATE_PAUSED
+        return s.STATE_STOPPED if self.stopped and self.body.steps == 0 else s.STATE_PAUSED
 
     # ------------------------------------------------------------------ simulation
     def _features(self, _request, response):
