@@ -1,16 +1,18 @@
 """
-attitude_fleet over real topics: several bodies in one process, each behind its own namespace.
+attitude_fleet over real topics: bodies in namespaces, in one process or over worker processes.
 
 Each body must behave exactly like a separate attitude_simulator: its own
 preset from a parameters file, the exact free motion at its stamps, its own
-torque commands and services, and a clean exit of the whole process.
+torque commands and services, and a clean exit of the whole fleet; a worker
+that dies is said on /diagnostics and in the exit code.
 """
 
+import os
 import signal
 import subprocess
 import time
 
-from diagnostic_msgs.msg import DiagnosticArray
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import InertiaStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -19,7 +21,7 @@ from rigid_body_dynamics.physics import presets
 from rigid_body_dynamics.ros.conversions import status_values, time_ns
 from ros_harness import assert_exact, LATCHED, relative, stamp
 from std_srvs.srv import SetBool
-from test_simulator_node import stop_cleanly
+
 
 FLEET = 'rigid_body_dynamics.nodes.fleet'
 PARAMS = """\
@@ -33,11 +35,48 @@ PARAMS = """\
 """
 
 
-def test_three_bodies_in_one_process(launch, probe, tmp_path):
-    """Per-body presets, exact motion, torque and pause on one body only, clean exit."""
+def stop_fleet(proc, within=5.0):
+    """SIGINT must end the fleet, workers and all, with exit code 0 within ``within`` s."""
+    code, seconds = proc.stop()
+    assert code == 0, proc.output()[-3000:]
+    assert seconds < within, proc.output()[-3000:]
+    assert 'Traceback' not in proc.output()
+
+
+def workers(probe, count):
+    """Return {worker number: status values} from the parent's /diagnostics (``count`` workers)."""
+    found = {}
+
+    def seen():
+        for array in probe.messages.get('/diagnostics', []):
+            for status in array.status:
+                if status.name.startswith('attitude_fleet: worker '):
+                    found[int(status.name.rsplit(' ', 1)[1])] = status_values(status)
+        return len(found) == count
+    probe.spin_until(seen, 20.0, f'{count} workers on /diagnostics')
+    return found
+
+
+def alive(pid):
+    """Tell whether process ``pid`` exists."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def test_three_bodies_over_two_processes(launch, probe, tmp_path):
+    """
+    Per-body presets, exact motion, torque and pause on one body only, clean exit of all.
+
+    Two worker processes: body1 and body3 in the first, body2 in the second; a body in
+    each answers its services and publishes the exact motion.
+    """
     params = tmp_path / 'fleet.yaml'
     params.write_text(PARAMS)
-    proc = launch(FLEET, '--params-file', str(params), '--', '--bodies', '3', name='fleet')
+    proc = launch(FLEET, '--params-file', str(params), '--', '--bodies', '3', '--processes', '2',
+                  name='fleet')
     probe.subscribe(DiagnosticArray, '/diagnostics')
     odom = {k: probe.subscribe(Odometry, f'/body{k}/odom') for k in (1, 2, 3)}
     inertia = {k: probe.subscribe(InertiaStamped, f'/body{k}/inertia', LATCHED)
@@ -58,6 +97,10 @@ def test_three_bodies_in_one_process(launch, probe, tmp_path):
                    if s.name.endswith(': integrator')}
     assert integrators['/body2/attitude_simulator'] == 'rk4'
     assert integrators['/body1/attitude_simulator'] == 'exact'
+    found = workers(probe, 2)
+    assert {k: v['bodies'] for k, v in found.items()} == {1: 'body1, body3', 2: 'body2'}
+    pids = {k: int(v['pid']) for k, v in found.items()}
+    assert len(set(pids.values()) | {proc.proc.pid}) == 3          # two workers and the parent
 
     # a torque on body 3 changes body 3 only
     applied = probe.subscribe(WrenchStamped, '/body3/applied_torque')
@@ -72,14 +115,41 @@ def test_three_bodies_in_one_process(launch, probe, tmp_path):
     assert_exact(relative(odom[1], start[1]), top.moments, top.omega0, top.q0)
     assert len(odom[1]) > n1
 
-    # pausing body 2 leaves the others running
+    # pausing body 2 (the second worker) leaves the others running; body 1 (the first)
+    # answers its pause service too
     paused = probe.call(SetBool, '/body2/attitude_simulator/pause', SetBool.Request(data=True))
     assert paused.success
+    resumed = probe.call(SetBool, '/body1/attitude_simulator/pause', SetBool.Request(data=False))
+    assert resumed.success
     probe.spin_for(0.3)
     n2, n1 = len(odom[2]), len(odom[1])
     probe.spin_for(0.5)
     assert len(odom[2]) == n2 and len(odom[1]) >= n1 + 15
-    stop_cleanly(proc)
+    stop_fleet(proc)
+    assert not any(alive(pid) for pid in pids.values())
+
+
+def test_a_worker_that_dies_is_reported_and_fails_the_fleet(launch, probe):
+    """SIGKILL one worker: ERROR on /diagnostics and in the log, the other runs on, exit 1."""
+    proc = launch(FLEET, '-p', 'publish_rate:=50.0', '--', '--bodies', '2', '--processes', '2',
+                  name='fleet')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    odom = probe.subscribe(Odometry, '/body1/odom')
+    probe.wait_for('/body1/odom', 5, timeout=30.0)
+    pids = {k: int(v['pid']) for k, v in workers(probe, 2).items()}
+    os.kill(pids[2], signal.SIGKILL)
+    probe.spin_until(lambda: (probe.newest_status('attitude_fleet: worker 2') or (0,))[0]
+                     == DiagnosticStatus.ERROR, 10.0, 'worker 2 reported dead')
+    level, message, values = probe.newest_status('attitude_fleet: worker 2')
+    assert message == 'exited with signal SIGKILL: bodies body2 are gone'
+    assert values['exit code'] == str(-signal.SIGKILL)
+    assert probe.newest_status('attitude_fleet: worker 1')[0] == DiagnosticStatus.OK
+    n1 = len(odom)
+    probe.wait_for('/body1/odom', n1 + 10)             # the other worker's body runs on
+    code, _ = proc.stop()
+    assert code == 1
+    assert 'worker 2 (pid %d) exited with signal SIGKILL' % pids[2] in proc.output()
+    assert not alive(pids[1])
 
 
 def test_bad_options_are_refused(launch):
@@ -101,7 +171,8 @@ def test_one_clock_source_only(launch):
 
 def test_an_overloaded_fleet_of_128_bodies_exits_cleanly_before_launch_kills_it(launch, probe):
     """Exit cleanly (code 0) before ros2 launch's SIGKILL, 10 s after its SIGINT."""
-    proc = launch(FLEET, '-p', 'preset:=tennis_racket', '--', '--bodies', '128', name='fleet')
+    proc = launch(FLEET, '-p', 'preset:=tennis_racket', '--', '--bodies', '128', '--processes',
+                  '1', name='fleet')
     probe.subscribe(Odometry, '/body128/odom')
     probe.wait_for('/body128/odom', 10, timeout=120.0)
     # the first body and the last (in the last of 8 DDS participants) serve their services

@@ -18,6 +18,9 @@ def _guard():
     received = []
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda signum, _frame: received.append(signum))
+    # a fleet's worker starts with both blocked (fleet_supervisor.py): one that came while
+    # this interpreter started is delivered now, to the handler
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, (signal.SIGINT, signal.SIGTERM))
     return received
 
 

@@ -27,6 +27,7 @@ from rclpy.context import Context
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
+from . import fleet_supervisor
 from .simulator import AttitudeSimulator, DIAGNOSTIC_PERIOD, integration_loop, NODE_NAME
 from .simulator import SWITCH_INTERVAL
 from ..engine.loop import FLEET_PUBLISH_BUDGET, Loop
@@ -85,7 +86,8 @@ class Fleet:
             raise
         self._untangle_tf()
         self.context = self.nodes[0].context     # the first participant's: rclpy.init's
-        self._logger.info(f'{len(names)} bodies in this process, one integration thread, '
+        self._logger.info(f'{len(names)} bod{"y" if len(names) == 1 else "ies"} in this '
+                          'process, one integration thread, '
                           f'{1 + len(self._contexts)} DDS participants')
 
     def _untangle_tf(self):
@@ -135,19 +137,49 @@ def main(args=None, early=None):
     argv = sys.argv if args is None else args
     parser = argparse.ArgumentParser(
         prog='attitude_fleet',
-        description='Many attitude_simulator bodies in one process, one namespace each.')
+        description='Many attitude_simulator bodies, one namespace each, over one or more '
+                    'processes.')
     parser.add_argument('--bodies', type=int, default=4,
                         help='number of bodies, named <prefix>1 ... <prefix>N (default 4)')
     parser.add_argument('--prefix', default='body', help='namespace prefix (default body)')
     parser.add_argument('--names', default='',
                         help='comma-separated namespaces instead of --bodies/--prefix')
+    parser.add_argument('--processes', type=int, default=0,
+                        help='worker processes, bodies assigned round-robin (default: the '
+                             'cores this process may use, at most the number of bodies; '
+                             '1: every body in this process)')
+    parser.add_argument('--report-fd', type=int, default=-1, help=argparse.SUPPRESS)
     options = parser.parse_args(remove_ros_args(argv)[1:])
     try:
         names = body_names(options.bodies, options.prefix, options.names)
+        if options.processes < 0:
+            raise ConfigurationError('--processes must be at least 1 (0: one per core)')
     except ConfigurationError as err:
         parser.error(str(err))
+    processes = min(len(names), options.processes or fleet_supervisor.default_processes(
+        len(names)))
+    if processes > 1:
+        return fleet_supervisor.supervise(fleet_supervisor.assign(names, processes), argv,
+                                          early=early)
+    if options.report_fd >= 0:         # a worker of a fleet over processes
+        return run(lambda: _reported(Fleet(names, args=argv), options.report_fd), NODE_NAME,
+                   argv, early=early, on_start=_start_when_told, on_stop=Fleet.stop)
     return run(lambda: Fleet(names, args=argv), NODE_NAME, argv, early=early,
                on_start=Fleet.start, on_stop=Fleet.stop)
+
+
+def _reported(fleet, fd):
+    """Worker: tell the parent which of this process' bodies publish /clock; the fleet."""
+    fleet_supervisor.worker_report(fd, [n.get_namespace() for n in fleet.nodes
+                                        if n.publishes_clock])
+    return fleet
+
+
+def _start_when_told(fleet):
+    """Worker: start stepping when the parent says go; stop when it closes the lifeline."""
+    if fleet_supervisor.wait_for_go():
+        fleet.start()
+    fleet_supervisor.watch_lifeline()
 
 
 if __name__ == '__main__':
