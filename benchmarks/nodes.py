@@ -71,10 +71,26 @@ FLOOR_RELAY = textwrap.dedent("""
 
 
 def cpu_seconds(pid):
-    """User + system CPU time (s) of a process, from /proc."""
+    """
+    User + system CPU time (s) of a process and its live descendants, from /proc.
+
+    The descendants count: attitude_fleet's worker processes are its children.
+    """
     with open(f'/proc/{pid}/stat') as f:
         fields = f.read().rsplit(')', 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+    total = (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+    for task in os.listdir(f'/proc/{pid}/task'):
+        try:
+            with open(f'/proc/{pid}/task/{task}/children') as f:
+                children = f.read().split()
+        except FileNotFoundError:            # a thread that ended meanwhile
+            continue
+        for child in children:
+            try:
+                total += cpu_seconds(int(child))
+            except FileNotFoundError:        # a child that ended meanwhile
+                pass
+    return total
 
 
 class Process:

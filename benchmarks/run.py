@@ -8,7 +8,7 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 ``--only nodes`` skips the physics sections; ``--only torque`` runs the
 torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak |
 soak-rt | flood | bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep |
-latency | publish | flow-batch | estimation``
+latency | publish | flow-batch | estimation | discovery``
 runs one reliability / scale measurement (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
@@ -51,7 +51,8 @@ def main():
                                            'lockstep', 'bodies-asymmetric', 'latency',
                                            'publish', 'flow-batch', 'command-path',
                                            'simulate-cost', 'wheels', 'wheels-node',
-                                           'environment', 'environment-node', 'estimation'],
+                                           'environment', 'environment-node', 'estimation',
+                                           'discovery'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -118,6 +119,7 @@ SCALE = {
     'environment': ('environment', 'A satellite in orbit beside Basilisk'),
     'environment-node': ('environment_node', 'attitude_simulator in orbit: CPU'),
     'estimation': ('estimation', "The estimator's sensors and the example MEKF"),
+    'discovery': ('discovery', 'DDS discovery time and the number of participants'),
 }
 
 

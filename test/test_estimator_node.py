@@ -58,6 +58,9 @@ def test_the_example_mekf_is_consistent_and_a_detuned_one_overconfident(launch, 
     probe.spin_until(lambda: sum(1 for a in probe.messages['/diagnostics'][seen:]
                                  for s in a.status if s.name.endswith(': estimation')) >= 4,
                      30.0, 'both estimation statuses after the run')
+    for name in ('attitude_estimator: filter', 'detuned_estimator: filter'):
+        # every gyro reading reached both (a lost one would make the NEES meaningless)
+        assert probe.newest_status(name)[2]['gyro gaps (readings missing)'] == '0'
     level, message, values = probe.newest_status('attitude_analyzer: estimation')
     assert values['verdict'] == 'consistent' and level == DiagnosticStatus.OK, message
     assert message.startswith('consistent: mean NEES')

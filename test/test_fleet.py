@@ -58,12 +58,12 @@ def workers(probe, count):
 
 
 def alive(pid):
-    """Tell whether process ``pid`` exists."""
+    """Tell whether process ``pid`` runs (a zombie waiting to be reaped has ended)."""
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
+        with open(f'/proc/{pid}/stat') as f:
+            return f.read().rsplit(')', 1)[1].split()[0] != 'Z'
+    except FileNotFoundError:
         return False
-    return True
 
 
 def test_three_bodies_over_two_processes(launch, probe, tmp_path):
@@ -92,9 +92,14 @@ def test_three_bodies_over_two_processes(launch, probe, tmp_path):
     assert_exact(relative(odom[1], start[1]), top.moments, top.omega0, top.q0)
     # rk4 at 1 kHz stays within 1e-12 rad of the exact motion over 5 s (offline check)
     assert_exact(relative(odom[2], start[2]), racket.moments, racket.omega0, racket.q0)
-    integrators = {s.hardware_id: status_values(s)['integrator']
-                   for a in probe.wait_for('/diagnostics', 6) for s in a.status
-                   if s.name.endswith(': integrator')}
+    integrators = {}
+
+    def integrator_of_each():
+        integrators.update({s.hardware_id: status_values(s)['integrator']
+                            for a in probe.messages['/diagnostics'] for s in a.status
+                            if s.name.endswith(': integrator')})
+        return len(integrators) == 3
+    probe.spin_until(integrator_of_each, 10.0, "every body's diagnostics")
     assert integrators['/body2/attitude_simulator'] == 'rk4'
     assert integrators['/body1/attitude_simulator'] == 'exact'
     found = workers(probe, 2)
@@ -109,9 +114,9 @@ def test_three_bodies_over_two_processes(launch, probe, tmp_path):
     command.wrench.torque.z = 0.5
     n1 = len(odom[1])
     probe.handshake(pub, command, lambda: applied and applied[-1].wrench.torque.z == 0.5)
-    probe.spin_for(0.3)
-    w3 = np.array([[m.twist.twist.angular.z] for m in odom[3][-5:]])
-    assert np.all(w3 > top.omega0[2] + 1e-3)           # spun up about its axis
+    # spun up about its axis: 0.5 N m / 1.5 kg m^2 adds 1e-3 rad/s in 3 ms
+    probe.spin_until(lambda: all(m.twist.twist.angular.z > top.omega0[2] + 1e-3
+                                 for m in odom[3][-5:]), 10.0, 'body 3 spun up')
     assert_exact(relative(odom[1], start[1]), top.moments, top.omega0, top.q0)
     assert len(odom[1]) > n1
 
@@ -150,6 +155,17 @@ def test_a_worker_that_dies_is_reported_and_fails_the_fleet(launch, probe):
     assert code == 1
     assert 'worker 2 (pid %d) exited with signal SIGKILL' % pids[2] in proc.output()
     assert not alive(pids[1])
+
+
+def test_no_worker_outlives_a_killed_parent(launch, probe):
+    """SIGKILL the parent (no chance to clean up): its workers stop by themselves, exit 0."""
+    proc = launch(FLEET, '--', '--bodies', '2', '--processes', '2', name='fleet')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    pids = [int(v['pid']) for v in workers(probe, 2).values()]
+    proc.proc.kill()
+    proc.proc.wait(5.0)
+    probe.spin_until(lambda: not any(alive(pid) for pid in pids), 10.0, 'the workers gone')
+    assert 'Traceback' not in proc.output()
 
 
 def test_bad_options_are_refused(launch):
@@ -258,3 +274,38 @@ def test_a_fleet_body_in_orbit_beside_a_free_one(launch, probe, tmp_path):
     for got, true in matched:
         assert max(abs(got.x - true.x), abs(got.y - true.y), abs(got.z - true.z),
                    abs(got.w - true.w)) < 1e-15
+
+
+def test_bodies_that_share_frames_across_workers_do_not_broadcast_tf(launch, tf2_msgs_env,
+                                                                      tmp_path):
+    """
+    Check that the fleet's TF rule holds across its workers.
+
+    body1 (first worker) and body2 (second) share odom -> base_link (an empty frame_prefix for
+    all), so neither broadcasts it; body3 has a body_frame of its own and does. The
+    fleet says which bodies it silenced.
+    """
+    import json
+    import sys
+    params = tmp_path / 'fleet.yaml'
+    params.write_text("""\
+/**/attitude_simulator:
+  ros__parameters:
+    frame_prefix: ''
+    publish_rate: 50.0
+/body3/attitude_simulator:
+  ros__parameters:
+    body_frame: body3_link
+""")
+    proc = launch(FLEET, '--params-file', str(params), '--', '--bodies', '3', '--processes',
+                  '2', name='fleet', env=tf2_msgs_env)
+    listener = subprocess.run(
+        [sys.executable, os.path.join(os.path.dirname(__file__), 'tf_listener.py'),
+         '--count', '50', '--odom', '/body2/odom'], env=dict(os.environ, **tf2_msgs_env),
+        capture_output=True, text=True, timeout=90)
+    assert listener.returncode == 0, listener.stderr[-3000:]
+    got = json.loads(listener.stdout)
+    assert {(t[1], t[2]) for m in got['tf'] for t in m} == {('odom', 'body3_link')}
+    assert len(got['publishers']) == 1
+    assert '2 bodies have the same frames (odom -> base_link)' in proc.output()
+    stop_fleet(proc)

@@ -14,28 +14,36 @@ import sys
 
 from diagnostic_msgs.msg import DiagnosticStatus
 import netns
+import numpy as np
 import pytest
+from rigid_body_dynamics.physics import presets
 from ros_harness import interrupt
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SIM = 'rigid_body_dynamics.nodes.simulator'
 ANALYZER = 'rigid_body_dynamics.nodes.analyzer'
+FLEET = 'rigid_body_dynamics.nodes.fleet'
+
+
+def made_hosts(names):
+    """Make hosts ``names`` on a private subnet (skip where this machine cannot)."""
+    reason = netns.unavailable()
+    if reason:
+        pytest.skip(reason)
+    return netns.Hosts(names)
 
 
 @pytest.fixture
 def hosts():
     """Make three hosts, sim, analyzer and operator, on a private subnet; removed afterwards."""
-    reason = netns.unavailable()
-    if reason:
-        pytest.skip(reason)
-    with netns.Hosts(['sim', 'analyzer', 'operator']) as made:
+    with made_hosts(['sim', 'analyzer', 'operator']) as made:
         yield made
 
 
-def start(hosts, host, module, log_path, *params):
-    """Start a node in ``host`` with its output in ``log_path``."""
+def start(hosts, host, module, log_path, *params, options=()):
+    """Start a node in ``host`` with its output in ``log_path`` (``options`` before ROS's)."""
     log = open(log_path, 'w')
-    cmd = [sys.executable, '-m', module, '--ros-args']
+    cmd = [sys.executable, '-m', module, *options, '--ros-args']
     for p in params:
         cmd += ['-p', p]
     proc = hosts.popen(host, cmd, stdout=log, stderr=subprocess.STDOUT)
@@ -91,3 +99,33 @@ def test_simulator_and_analyzer_on_different_hosts(hosts, probe, tmp_path):
     trips = sorted(report['round_trips'])
     assert len(trips) >= 0.9 * report['rounds']
     assert trips[len(trips) // 2] < 0.05
+
+
+def test_one_fleet_split_over_two_hosts(probe, tmp_path):
+    """
+    Run bodies 1-2 of a fleet on one host and 3-4 on another (two processes each).
+
+    An operator on a third host sees every body by its name, each with the exact free
+    motion at its stamps (1e-9 rad) and answering its pause service, as one fleet would.
+    """
+    names = ['body1', 'body2', 'body3', 'body4']
+    top = presets.get('symmetric_top')
+    with made_hosts(['fleet_a', 'fleet_b', 'operator']) as hosts:
+        procs = [start(hosts, host, FLEET, tmp_path / f'{host}.log', 'publish_rate:=50.0',
+                       options=('--bodies', '2', '--first', first, '--processes', '2'))
+                 for host, first in (('fleet_a', '1'), ('fleet_b', '3'))]
+        try:
+            done = hosts.run('operator', [sys.executable, os.path.join(HERE, 'netns_operator.py'),
+                                          '--fleet', ','.join(names), '--timeout', '60'],
+                             timeout=150)
+            assert done.returncode == 0, done.stdout + done.stderr
+            report = json.loads(done.stdout.strip().splitlines()[-1])
+        finally:
+            results = [stop(p) for p in procs]
+    for code, output in results:
+        assert code == 0, output
+        assert 'Traceback' not in output
+    assert sorted(report) == names
+    for name, (attitude, rate, paused) in report.items():
+        assert attitude < 1e-9 and rate < 1e-9 * np.linalg.norm(top.omega0), (name, attitude, rate)
+        assert paused, name

@@ -98,6 +98,13 @@ PARAMETERS = ParameterTable([
 ], cross_checks=(_models,))
 
 
+#: A gyro interval longer than this times the shortest one seen is a gap: readings lost.
+GAP = 1.5
+#: Diagnostic value names of the counters that are not messages used.
+NAMES = {'late': 'late readings dropped', 'gyro gaps': 'gyro gaps (readings missing)',
+         'restarts': 'restarts'}
+
+
 class AttitudeEstimator(Node):
     """The attitude_estimator node; ``kwargs`` go to rclpy's Node."""
 
@@ -109,7 +116,8 @@ class AttitudeEstimator(Node):
         self._pending = []            # heap of (stamp ns, kind order, sequence, kind, data)
         self._sequence = 0
         self.counts = dict.fromkeys(('gyro', 'star_tracker', 'sun_sensor', 'magnetometer',
-                                     'late', 'restarts'), 0)
+                                     'late', 'gyro gaps', 'restarts'), 0)
+        self._gyro_interval = None    # the shortest interval between gyro stamps seen (ns)
         self._restart()
         self._pub = self.create_publisher(PoseWithCovarianceStamped, 'attitude_estimate',
                                           STATE_QOS)
@@ -177,12 +185,26 @@ class AttitudeEstimator(Node):
         """Propagate to a gyro sample's stamp with the previous sample's rate (held)."""
         last, self._gyro = self._gyro, (stamp, omega)
         self.counts['gyro'] += 1
+        if last is not None and stamp > last[0]:
+            self._check_gap(stamp - last[0])
         if not self.filter.started:
             return False
         held = omega if last is None else last[1]
         self.filter.propagate(held, (stamp - self._time) * 1e-9)
         self._time = stamp
         return True
+
+    def _check_gap(self, interval):
+        """Count (and warn of) a gyro interval over GAP times the shortest seen (ns)."""
+        shortest = self._gyro_interval = min(interval, self._gyro_interval or interval)
+        if interval > GAP * shortest:
+            self.counts['gyro gaps'] += 1
+            self.get_logger().warning(
+                f'gyro readings missing: {interval * 1e-6:.3g} ms between two where '
+                f'{shortest * 1e-6:.3g} ms is usual ({self.counts["gyro gaps"]} gaps so far); '
+                'the estimate holds the rate across them and is worse than it says (a busy '
+                'machine? a deeper queue: qos_overrides./imu.subscription.depth)',
+                throttle_duration_sec=5.0)
 
     def _update(self, stamp, kind, msg):
         """Correct with one reading at its stamp (after propagating to it); False if not used."""
@@ -259,8 +281,7 @@ class AttitudeEstimator(Node):
         else:
             level, message = DiagnosticStatus.OK, 'waiting for the first star_tracker reading'
             values = []
-        values += [(f'{kind} messages used' if kind not in ('late', 'restarts') else
-                    {'late': 'late readings dropped', 'restarts': 'restarts'}[kind], n)
+        values += [(NAMES.get(kind, f'{kind} messages used'), n)
                    for kind, n in self.counts.items()]
         array = DiagnosticArray(status=[conv.status(
             f'{self.get_name()}: filter', level, message, values,

@@ -1,24 +1,27 @@
 """
-attitude_fleet: many bodies in one process, each a full attitude_simulator in its own namespace.
+attitude_fleet: many bodies, each a full attitude_simulator in its own namespace.
 
 Every body is an ``AttitudeSimulator`` in ``/<name>``, with the topics, services, parameters
 and diagnostics of ``attitude_simulator --ros-args -r __ns:=/<name>``. ``-p`` sets every body,
 a parameters file one (``/<name>/attitude_simulator``) or all (``/**/attitude_simulator``).
-One interpreter, one executor and one engine Loop thread serve all bodies (benchmarks/
-bodies.py); the bodies are spread over one DDS participant per BODIES_PER_PARTICIPANT
-(Fast DDS tears a participant's entities down in a time that grows with the square of their
-number). Each body's frame ids carry its name (``frame_prefix`` ``<name>/``: body1/odom ->
-body1/base_link), so every body broadcasts a TF tree of its own; bodies that still share
-frames (a ``frame_prefix`` given to all) do not broadcast /tf. One body at most publishes
-/clock; an as-fast-as-possible body makes the others late (run it in its own process).
-ROS 2's standard simulator services (``simulation_interfaces``) are off unless set, for a
-body or for all: their endpoints made 128 bodies start and exit 2.5-3 times slower.
+The bodies go round-robin to ``--processes`` worker processes (default: one per core this
+process may use; fleet_supervisor.py starts, watches and stops them); with one, this process
+hosts them all. In a process, one interpreter, one executor and one engine Loop thread serve
+its bodies (benchmarks/bodies.py), spread over one DDS participant per
+BODIES_PER_PARTICIPANT (Fast DDS tears a participant's entities down in a time that grows
+with the square of their number). Each body's frame ids carry its name (``frame_prefix``
+``<name>/``: body1/odom -> body1/base_link), so every body broadcasts a TF tree of its own;
+bodies of a process that still share frames (a ``frame_prefix`` given to all) do not
+broadcast /tf. One body at most publishes /clock; an as-fast-as-possible body makes the
+others of its process late (run it in its own process). ROS 2's standard simulator services
+(``simulation_interfaces``) are off unless set, for a body or for all: their endpoints made
+128 bodies start and exit 2.5-3 times slower.
 
-``attitude_fleet [--bodies N] [--prefix body] [--names a,b,...] [--ros-args ...]``
+``attitude_fleet [--bodies N] [--prefix body] [--first K] [--names a,b,...]
+[--processes P] [--ros-args ...]``
 """
 
 import argparse
-import collections
 import sys
 import threading
 
@@ -36,12 +39,18 @@ from ..ros.parameters import ConfigurationError
 from ..ros.runner import run
 
 
-def body_names(bodies, prefix, names):
-    """Namespaces of the bodies: ``names`` (comma-separated) or prefix1 ... prefixN."""
+def body_names(bodies, prefix, names, first=1):
+    """
+    Return the namespaces of the bodies.
+
+    ``names`` (comma-separated), else <prefix><first> ... <prefix><first + bodies - 1>.
+    """
     out = ([n.strip().strip('/') for n in names.split(',')] if names else
-           [f'{prefix}{k}' for k in range(1, bodies + 1)])
+           [f'{prefix}{k}' for k in range(first, first + bodies)])
     if not names and bodies < 1:
         raise ConfigurationError('--bodies must be at least 1')
+    if not names and first < 0:
+        raise ConfigurationError('--first must be at least 0')
     if not out or any(not n for n in out):
         raise ConfigurationError(f'no valid body names in {names!r}')
     if len(set(out)) != len(out):
@@ -60,7 +69,7 @@ BODIES_PER_PARTICIPANT = 16
 class Fleet:
     """The bodies of one process and the thread that steps them."""
 
-    def __init__(self, names, args=None, **kwargs):
+    def __init__(self, names, args=None, untangle=True, **kwargs):
         self._logger = rclpy.logging.get_logger('attitude_fleet')
         self.nodes, self._stop, self._thread = [], threading.Event(), None
         self._contexts = []          # participants after the first (the default context)
@@ -74,6 +83,7 @@ class Fleet:
                     kwargs['context'] = context
                 self.nodes.append(AttitudeSimulator(frame_prefix_default=name + '/',
                                                     simulation_interfaces_default=False,
+                                                    defer_first_state=True,
                                                     namespace='/' + name, **kwargs))
             clocks = [n.get_namespace() for n in self.nodes if n.publishes_clock]
             if len(clocks) > 1:
@@ -84,27 +94,33 @@ class Fleet:
         except Exception:
             self._destroy()
             raise
-        self._untangle_tf()
+        if untangle:                # a worker's parent does it for the whole fleet
+            self._untangle_tf()
         self.context = self.nodes[0].context     # the first participant's: rclpy.init's
         self._logger.info(f'{len(names)} bod{"y" if len(names) == 1 else "ies"} in this '
                           'process, one integration thread, '
                           f'{1 + len(self._contexts)} DDS participants')
 
+    def tf_frames(self):
+        """Return {namespace: 'world -> body'} of the bodies that broadcast /tf."""
+        return {n.get_namespace(): f'{n.state.world_frame} -> {n.state.body_frame}'
+                for n in self.nodes if n.state.broadcasts_tf}
+
+    def stop_tf(self, namespaces):
+        """Stop /tf for the bodies in ``namespaces`` (they share frames with another body)."""
+        for node in self.nodes:
+            if node.get_namespace() in namespaces:
+                node.state.stop_tf(node)
+
     def _untangle_tf(self):
         """Stop /tf for bodies whose (world, body) frames another body also broadcasts."""
-        pairs = {n: f'{n.state.world_frame} -> {n.state.body_frame}' for n in self.nodes}
-        frames = collections.Counter(pairs[n] for n in self.nodes if n.state.broadcasts_tf)
-        shared = [n for n in self.nodes if frames[pairs[n]] > 1]
-        for node in shared:
-            node.state.stop_tf(node)
-        if shared:
-            self._logger.warning(
-                f'{len(shared)} bodies have the same frames ({", ".join(sorted(frames))}): '
-                'they do not broadcast /tf, which would mix them; give each its own body_frame '
-                '(key /<name>/attitude_simulator) to get TF')
+        shared = fleet_supervisor.shared_frames(self.tf_frames(), self._logger)
+        self.stop_tf(shared)
 
     def start(self):
         """Start the thread that steps every body (diagnostics too: no timer per body)."""
+        for node in self.nodes:         # now that the fleet has decided who broadcasts /tf
+            node.publish_first_state()
         sys.setswitchinterval(SWITCH_INTERVAL)
         spread_phases(node.pace for node in self.nodes)     # a few bodies due at a time
         loop = Loop([node.member(diagnostics=True) for node in self.nodes],
@@ -142,6 +158,10 @@ def main(args=None, early=None):
     parser.add_argument('--bodies', type=int, default=4,
                         help='number of bodies, named <prefix>1 ... <prefix>N (default 4)')
     parser.add_argument('--prefix', default='body', help='namespace prefix (default body)')
+    parser.add_argument('--first', type=int, default=1,
+                        help='number of the first body (default 1): with --bodies N, '
+                             '<prefix><first> ... <prefix><first+N-1>, a range of a fleet split '
+                             'over hosts')
     parser.add_argument('--names', default='',
                         help='comma-separated namespaces instead of --bodies/--prefix')
     parser.add_argument('--processes', type=int, default=0,
@@ -151,7 +171,7 @@ def main(args=None, early=None):
     parser.add_argument('--report-fd', type=int, default=-1, help=argparse.SUPPRESS)
     options = parser.parse_args(remove_ros_args(argv)[1:])
     try:
-        names = body_names(options.bodies, options.prefix, options.names)
+        names = body_names(options.bodies, options.prefix, options.names, options.first)
         if options.processes < 0:
             raise ConfigurationError('--processes must be at least 1 (0: one per core)')
     except ConfigurationError as err:
@@ -162,22 +182,25 @@ def main(args=None, early=None):
         return fleet_supervisor.supervise(fleet_supervisor.assign(names, processes), argv,
                                           early=early)
     if options.report_fd >= 0:         # a worker of a fleet over processes
-        return run(lambda: _reported(Fleet(names, args=argv), options.report_fd), NODE_NAME,
+        return run(lambda: _reported(Fleet(names, args=argv, untangle=False), options.report_fd),
+               NODE_NAME,
                    argv, early=early, on_start=_start_when_told, on_stop=Fleet.stop)
     return run(lambda: Fleet(names, args=argv), NODE_NAME, argv, early=early,
                on_start=Fleet.start, on_stop=Fleet.stop)
 
 
 def _reported(fleet, fd):
-    """Worker: tell the parent which of this process' bodies publish /clock; the fleet."""
+    """Worker: tell the parent which bodies publish /clock and /tf here; return the fleet."""
     fleet_supervisor.worker_report(fd, [n.get_namespace() for n in fleet.nodes
-                                        if n.publishes_clock])
+                                        if n.publishes_clock], fleet.tf_frames())
     return fleet
 
 
 def _start_when_told(fleet):
     """Worker: start stepping when the parent says go; stop when it closes the lifeline."""
-    if fleet_supervisor.wait_for_go():
+    go = fleet_supervisor.wait_for_go()
+    if go is not None:
+        fleet.stop_tf(go['no_tf'])
         fleet.start()
     fleet_supervisor.watch_lifeline()
 

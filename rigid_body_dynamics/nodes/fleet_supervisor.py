@@ -5,15 +5,18 @@ Each worker is ``attitude_fleet --names <its bodies> --processes 1`` with the us
 ``--ros-args``: its own interpreter, integration thread and DDS participants. The bodies
 go round-robin (worker k of P has bodies k, k + P, ...). The start is in two phases, so
 that a configuration the fleet as a whole refuses starts nothing: every worker builds its
-bodies and reports them on a pipe (which of them publish /clock), and only when all have
-reported does the parent tell them to go (a line on their stdin). The parent's own node
+bodies and reports them on a pipe (which of them publish /clock, and their TF frames), and
+only when all have reported does the parent tell them to go (a line on their stdin, with
+the bodies whose /tf must stop). The parent's own node
 ``attitude_fleet`` publishes one /diagnostics status per worker (ERROR once it has died,
-with its exit code and its bodies) every second and at once on a death.
+with its exit code and its bodies) every second and at once on a death. The fleet's rules
+hold across the workers: one /clock source at most, and no /tf from bodies that share frames.
 
 The worker's stdin is its lifeline: when it closes (the parent stops, or dies even by
 SIGKILL) the worker stops cleanly as on SIGINT, so no worker outlives its fleet.
 """
 
+import collections
 import json
 import os
 import selectors
@@ -54,15 +57,39 @@ def assign(names, processes):
     return [names[k::processes] for k in range(processes)]
 
 
-def worker_report(fd, clocks):
-    """Worker side: report the bodies that publish /clock to the parent on pipe ``fd``."""
+def shared_frames(frames, logger):
+    """
+    Return the namespaces whose TF frames another body also broadcasts, and say so.
+
+    ``frames``: {namespace: 'world -> body'} of the bodies that broadcast /tf. Their /tf
+    must stop, as it would mix the bodies (a ``frame_prefix`` given to all).
+    """
+    count = collections.Counter(frames.values())
+    shared = sorted(ns for ns, pair in frames.items() if count[pair] > 1)
+    if shared:
+        logger.warning(
+            f'{len(shared)} bodies have the same frames '
+            f'({", ".join(sorted({frames[ns] for ns in shared}))}): they do not broadcast '
+            '/tf, which would mix them; give each its own body_frame '
+            '(key /<name>/attitude_simulator) to get TF')
+    return shared
+
+
+def worker_report(fd, clocks, frames):
+    """
+    Worker side: report to the parent on pipe ``fd``.
+
+    ``clocks``: the namespaces of the bodies that publish /clock; ``frames``: {namespace:
+    'world -> body'} of those that broadcast /tf.
+    """
     with os.fdopen(fd, 'w') as pipe:
-        pipe.write(json.dumps({'clocks': clocks}) + '\n')
+        pipe.write(json.dumps({'clocks': clocks, 'frames': frames}) + '\n')
 
 
 def wait_for_go():
-    """Worker side: wait for the parent's go on stdin; False if it closed stdin instead."""
-    return sys.stdin.readline().strip() == 'go'
+    """Worker side: wait for the parent's go on stdin: its orders, or None if stdin closed."""
+    line = sys.stdin.readline()
+    return json.loads(line) if line.strip() else None
 
 
 def watch_lifeline():
@@ -187,8 +214,10 @@ class Supervisor:
                 f'publish_clock is set for {len(clocks)} bodies ({", ".join(clocks[:3])}'
                 f'{", ..." if len(clocks) > 3 else ""}); /clock must have one source, so '
                 'set it for one body only (key /<name>/attitude_simulator)')
+        frames = {ns: pair for w in self.workers for ns, pair in w.report['frames'].items()}
+        go = json.dumps({'no_tf': shared_frames(frames, self.logger)})
         for worker in self.workers:
-            worker.tell('go')
+            worker.tell(go)
 
     def watch(self):
         """Until the stop or every worker's death: report deaths, publish /diagnostics."""

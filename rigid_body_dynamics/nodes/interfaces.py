@@ -374,7 +374,7 @@ ESTIMATOR = Interfaces('attitude_estimator', [
               "The gyro bias estimate (rad/s, `body_frame`) at the estimate's stamp."),
     Interface('pub', '/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray',
               '1 Hz: `<node>: filter` (its sigmas, the bias, readings used, late readings '
-              'dropped, restarts).'),
+              'dropped, gyro gaps (readings missing), restarts).'),
 ])
 
 #: Every node's table, by executable name.

@@ -114,7 +114,8 @@ class AttitudeSimulator(Node):
     every body's :meth:`member` on one Loop instead.
     """
 
-    def __init__(self, frame_prefix_default='', simulation_interfaces_default=True, **kwargs):
+    def __init__(self, frame_prefix_default='', simulation_interfaces_default=True,
+                 defer_first_state=False, **kwargs):
         # the defaults attitude_fleet changes: frame_prefix (each body's name) and
         # simulation_interfaces (off: their endpoints cost a large fleet its start and exit)
         self.frame_prefix_default = frame_prefix_default
@@ -157,10 +158,8 @@ class AttitudeSimulator(Node):
         self._report = SimulatorReport(self.body, self.pace, self.lockstep)
         self._make_interfaces()
         self.state.publish_inertia(self.body.inertia, start_ns)
-        with self.body.lock:
-            items = self.pace.first_items()
-        for item in items:
-            self.state.publish(item)
+        if not defer_first_state:
+            self.publish_first_state()
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.add_post_set_parameters_callback(self._post_set_parameters)
         body = self.body.inertia
@@ -350,6 +349,18 @@ class AttitudeSimulator(Node):
             args=(Loop([self.member()]), self._stop, self.thread_priority, self.get_logger(),
                   self.context))
         self._thread.start()
+
+    def publish_first_state(self):
+        """
+        Publish the state at simulated time 0 (odom, /tf, ...; lockstep's first question).
+
+        The node does so when it is made, unless told to defer it (``defer_first_state``:
+        attitude_fleet first decides which bodies broadcast /tf).
+        """
+        with self.body.lock:
+            items = self.pace.first_items()
+        for item in items:
+            self.state.publish(item)
 
     @property
     def publishes_clock(self):
