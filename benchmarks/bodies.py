@@ -1,19 +1,18 @@
 """
 Many bodies on one machine: how many run in real time at 1 kHz integration and 100 Hz publishing.
 
-Three ways, all with the defaults of the symmetric top (exact integrator, 7
-state topics per body): one ``attitude_simulator`` process per body (a
-namespace each), ``attitude_fleet --processes 1`` (every body in one process,
-sharing one integration thread; a thread per body, measured before: 4 bodies, was
-removed), and ``attitude_fleet --processes 2`` (the bodies round-robin over two
-worker processes, one per core; the CPU counts the parent and both workers). For each count N the bodies start, run until every one has
-reported, and then for a window the CPU of all processes is summed and every
-body's diagnostics are read. N runs in real time when every body achieved a
-real-time factor of at least 0.99 and at most 2 of its steps were more than
-5 ms late in the window (the criterion of the single-node rate sweep, per
-body; in one process a single 5 ms stall of the machine makes every body late
-at once, so the total counts each stall N times). Each sweep ends after two failures in
-a row. ``./dev bench --only bodies`` (about 25 minutes).
+Three ways, all with the defaults of the symmetric top (exact integrator, 7 state topics per
+body): one ``attitude_simulator`` process per body (a namespace each), ``attitude_fleet
+--processes 1`` (every body in one process, sharing one integration thread; a thread per
+body, measured before: 4 bodies, was removed), and ``attitude_fleet --processes 2`` (the
+bodies round-robin over two worker processes, one per core; the CPU counts the parent and
+both workers). For each count N the bodies start, run until every one has reported, and then
+for a window the CPU of all processes is summed and every body's diagnostics are read. N
+runs in real time when every body achieved a real-time factor of at least 0.99 and at most 2
+of its steps were more than 5 ms late in the window (the criterion of the single-node rate
+sweep, per body; in one process a single 5 ms stall of the machine makes every body late at
+once, so the total counts each stall N times). Each sweep ends after two failures in a row.
+``./dev bench --only bodies`` (about 25 minutes).
 """
 
 import os
@@ -143,8 +142,8 @@ def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128, 160)):
             for n in counts:
                 cpu, missed, slowest, why = run_bodies(probe, way, n, window, ASYMMETRIC + extra)
                 ok = not why and missed[1] <= MAX_MISSED and slowest >= 0.99
-                lines.append(f'| {label} | {way[-11]} | {n} | {cpu:.2f} | {100 * cpu / n:.1f} | '
-                             f'{missed[0]} / {missed[1]} | {slowest:.3f} | '
+                lines.append(f'| {label} | {way.split()[-2]} | {n} | {cpu:.2f} | '
+                             f'{100 * cpu / n:.1f} | {missed[0]} / {missed[1]} | {slowest:.3f} | '
                              f'{"yes" if ok else "no"}{", " + why if why else ""} |')
                 print(lines[-1], flush=True)
                 if ok:
@@ -154,6 +153,6 @@ def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128, 160)):
                     break
     finally:
         probe.close()
-    summary = '; '.join(f'{label}, {way[-11:]}: {best.get((label, way), 0)}'
+    summary = '; '.join(f'{label}, {way.split(", ")[-1]}: {best.get((label, way), 0)}'
                         for label, way, _ in ASYMMETRIC_SETUPS)
     return lines + ['', f'Most asymmetric bodies in real time: {summary}.']

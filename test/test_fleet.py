@@ -276,8 +276,8 @@ def test_a_fleet_body_in_orbit_beside_a_free_one(launch, probe, tmp_path):
                    abs(got.w - true.w)) < 1e-15
 
 
-def test_bodies_that_share_frames_across_workers_do_not_broadcast_tf(launch, tf2_msgs_env,
-                                                                      tmp_path):
+def test_bodies_that_share_frames_across_workers_do_not_broadcast_tf(
+        launch, tf2_msgs_env, tmp_path):
     """
     Check that the fleet's TF rule holds across its workers.
 

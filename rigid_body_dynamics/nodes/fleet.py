@@ -11,8 +11,8 @@ its bodies (benchmarks/bodies.py), spread over one DDS participant per
 BODIES_PER_PARTICIPANT (Fast DDS tears a participant's entities down in a time that grows
 with the square of their number). Each body's frame ids carry its name (``frame_prefix``
 ``<name>/``: body1/odom -> body1/base_link), so every body broadcasts a TF tree of its own;
-bodies of a process that still share frames (a ``frame_prefix`` given to all) do not
-broadcast /tf. One body at most publishes /clock; an as-fast-as-possible body makes the
+bodies that still share frames (a ``frame_prefix`` given to all), in any of the processes,
+do not broadcast /tf. One body at most publishes /clock; an as-fast-as-possible body makes the
 others of its process late (run it in its own process). ROS 2's standard simulator services
 (``simulation_interfaces``) are off unless set, for a body or for all: their endpoints made
 128 bodies start and exit 2.5-3 times slower.
@@ -182,9 +182,10 @@ def main(args=None, early=None):
         return fleet_supervisor.supervise(fleet_supervisor.assign(names, processes), argv,
                                           early=early)
     if options.report_fd >= 0:         # a worker of a fleet over processes
-        return run(lambda: _reported(Fleet(names, args=argv, untangle=False), options.report_fd),
-               NODE_NAME,
-                   argv, early=early, on_start=_start_when_told, on_stop=Fleet.stop)
+        def worker():
+            return _reported(Fleet(names, args=argv, untangle=False), options.report_fd)
+        return run(worker, NODE_NAME, argv, early=early, on_start=_start_when_told,
+                   on_stop=Fleet.stop)
     return run(lambda: Fleet(names, args=argv), NODE_NAME, argv, early=early,
                on_start=Fleet.start, on_stop=Fleet.stop)
 

@@ -114,7 +114,7 @@ class Worker:
         self.proc = subprocess.Popen(command, stdin=subprocess.PIPE, pass_fds=(write,),
                                      text=True)
         os.close(write)
-        self._report = os.fdopen(read)
+        self.report_pipe = os.fdopen(read)
         self.report = None
         self.death = None           # the exit code of a death before the stop
 
@@ -125,8 +125,8 @@ class Worker:
 
     def read_report(self):
         """Read the report (after the selector said it is there); None at EOF."""
-        line = self._report.readline()
-        self._report.close()
+        line = self.report_pipe.readline()
+        self.report_pipe.close()
         self.report = json.loads(line) if line else {}
         return self.report
 
@@ -193,7 +193,7 @@ class Supervisor:
 
     def start(self):
         """Wait for every worker's report, check the whole fleet, then tell them all to go."""
-        waiting = {w._report: w for w in self.workers}
+        waiting = {w.report_pipe: w for w in self.workers}
         with selectors.DefaultSelector() as selector:
             for pipe in waiting:
                 selector.register(pipe, selectors.EVENT_READ)
