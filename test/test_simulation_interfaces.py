@@ -11,6 +11,7 @@ import math
 import os
 
 from action_msgs.msg import GoalStatus
+from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
 from rigid_body_dynamics.physics import presets, quaternions, simulate
@@ -233,6 +234,12 @@ def test_each_fleet_body_answers_for_itself(launch, probe):
     """attitude_fleet, told so: each body has the services in its namespace and its own state."""
     launch('rigid_body_dynamics.nodes.fleet', '-p', 'simulation_interfaces:=true', '--',
            '--bodies', '2', name='fleet')
+    # both bodies step (each in a worker process of its own) before the first call: a service
+    # that answers a client it has not discovered yet drops the response (rmw_fastrtps waits
+    # 100 ms for the match), which beside a CPU hog lost one in a CI run
+    for ns in ('/body1', '/body2'):
+        probe.subscribe(Odometry, f'{ns}/odom')
+        probe.wait_for(f'{ns}/odom', 5, timeout=30.0)
     assert call(probe, 'get_entities', None, '/body2').entities == ['body2/base_link']
     assert set_state(probe, SimulationState.STATE_STOPPED, '/body1') == OK
     assert call(probe, 'step_simulation', sim_srv.StepSimulation.Request(steps=100),
