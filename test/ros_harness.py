@@ -246,3 +246,19 @@ class Probe(RosClient):
                 if status.name.endswith(name):
                     return status.level, status.message, status_values(status)
         return None
+
+
+def listen_tf(tf2_msgs_env, count, odom):
+    """
+    Run test/tf_listener.py (a process that can import the built tf2_msgs); its JSON report.
+
+    ``count`` /tf and ``odom`` messages: {'tf': [...], 'odom': [...], 'publishers': [...]}.
+    """
+    import json
+    import sys
+    listener = subprocess.run(
+        [sys.executable, os.path.join(os.path.dirname(__file__), 'tf_listener.py'),
+         '--count', str(count), '--odom', odom], env=dict(os.environ, **tf2_msgs_env),
+        capture_output=True, text=True, timeout=90)
+    assert listener.returncode == 0, listener.stderr[-3000:]
+    return json.loads(listener.stdout)

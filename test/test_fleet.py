@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 from rigid_body_dynamics.physics import presets
 from rigid_body_dynamics.ros.conversions import status_values, time_ns
-from ros_harness import assert_exact, LATCHED, relative, stamp
+from ros_harness import assert_exact, LATCHED, listen_tf, relative, stamp
 from std_srvs.srv import SetBool
 
 
@@ -285,8 +285,6 @@ def test_bodies_that_share_frames_across_workers_do_not_broadcast_tf(
     all), so neither broadcasts it; body3 has a body_frame of its own and does. The
     fleet says which bodies it silenced.
     """
-    import json
-    import sys
     params = tmp_path / 'fleet.yaml'
     params.write_text("""\
 /**/attitude_simulator:
@@ -299,12 +297,7 @@ def test_bodies_that_share_frames_across_workers_do_not_broadcast_tf(
 """)
     proc = launch(FLEET, '--params-file', str(params), '--', '--bodies', '3', '--processes',
                   '2', name='fleet', env=tf2_msgs_env)
-    listener = subprocess.run(
-        [sys.executable, os.path.join(os.path.dirname(__file__), 'tf_listener.py'),
-         '--count', '50', '--odom', '/body2/odom'], env=dict(os.environ, **tf2_msgs_env),
-        capture_output=True, text=True, timeout=90)
-    assert listener.returncode == 0, listener.stderr[-3000:]
-    got = json.loads(listener.stdout)
+    got = listen_tf(tf2_msgs_env, 50, '/body2/odom')
     assert {(t[1], t[2]) for m in got['tf'] for t in m} == {('odom', 'body3_link')}
     assert len(got['publishers']) == 1
     assert '2 bodies have the same frames (odom -> base_link)' in proc.output()

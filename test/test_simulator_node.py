@@ -19,7 +19,8 @@ from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
 from rigid_body_dynamics.physics import FreeRigidBody, Inertia, presets, quaternions, simulate
 from rigid_body_dynamics.ros.conversions import quaternion_array, time_ns, vector_array
-from ros_harness import assert_exact, LATCHED, odom_arrays, relative, stamp, status_count
+from ros_harness import assert_exact, LATCHED, listen_tf, odom_arrays, relative, stamp
+from ros_harness import status_count
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import SetBool, Trigger
 
@@ -427,19 +428,11 @@ def test_tf_is_broadcast_with_the_odom_stamp_and_frames(launch, tf2_msgs_env):
     (test/tf2_msgs_build.py); the /tf publisher's type hash is Jazzy's, so a ROS install's
     tf2 listeners and RViz accept it; tf2_ros' broadcaster QoS (reliable, volatile).
     """
-    import json
-    import subprocess
-    import sys
     import tf2_msgs_build
-    env = dict(os.environ, **tf2_msgs_env)
     proc = launch(SIM, '-p', 'publish_clock:=true', '-p', 'inertia:=[1.0, 2.0, 3.0]',
                   '-p', 'initial_angular_velocity:=[0.3, 1.5, -0.4]',
                   '-p', 'real_time_factor:=2.0', name='sim_tf', env=tf2_msgs_env)
-    listener = subprocess.run(
-        [sys.executable, os.path.join(os.path.dirname(__file__), 'tf_listener.py'),
-         '--count', '100'], env=env, capture_output=True, text=True, timeout=90)
-    assert listener.returncode == 0, listener.stderr[-3000:]
-    got = json.loads(listener.stdout)
+    got = listen_tf(tf2_msgs_env, 100, 'odom')
     odom = dict(got['odom'])                         # stamp -> quaternion
     assert all(len(m) == 1 for m in got['tf'])
     transforms = [m[0] for m in got['tf']]
@@ -465,18 +458,10 @@ def test_two_namespaced_simulators_give_two_tf_trees(launch, tf2_msgs_env):
     Each broadcasts its own sat<k>/odom -> sat<k>/base_link (and no plain odom ->
     base_link); odom carries the same frame ids.
     """
-    import json
-    import subprocess
-    import sys
     for k in (1, 2):
         launch(SIM, '-r', f'__ns:=/sat{k}', '-p', f'frame_prefix:=sat{k}/',
                '-p', 'real_time_factor:=2.0', name=f'sim{k}', env=tf2_msgs_env)
-    listener = subprocess.run(
-        [sys.executable, os.path.join(os.path.dirname(__file__), 'tf_listener.py'),
-         '--count', '100', '--odom', '/sat2/odom'], env=dict(os.environ, **tf2_msgs_env),
-        capture_output=True, text=True, timeout=90)
-    assert listener.returncode == 0, listener.stderr[-3000:]
-    got = json.loads(listener.stdout)
+    got = listen_tf(tf2_msgs_env, 100, '/sat2/odom')
     pairs = {(t[1], t[2]) for m in got['tf'] for t in m}
     assert pairs == {('sat1/odom', 'sat1/base_link'), ('sat2/odom', 'sat2/base_link')}, pairs
     assert len(got['publishers']) == 2

@@ -85,12 +85,8 @@ class Fleet:
                                                     simulation_interfaces_default=False,
                                                     defer_first_state=True,
                                                     namespace='/' + name, **kwargs))
-            clocks = [n.get_namespace() for n in self.nodes if n.publishes_clock]
-            if len(clocks) > 1:
-                raise ConfigurationError(
-                    f'publish_clock is set for {len(clocks)} bodies ({", ".join(clocks[:3])}'
-                    f'{", ..." if len(clocks) > 3 else ""}); /clock must have one source, so '
-                    'set it for one body only (key /<name>/attitude_simulator)')
+            fleet_supervisor.one_clock_source(
+                [n.get_namespace() for n in self.nodes if n.publishes_clock])
         except Exception:
             self._destroy()
             raise

@@ -32,6 +32,7 @@ from rclpy.signals import SignalHandlerOptions
 
 from ..ros.conversions import status
 from ..ros.parameters import ConfigurationError
+from ..ros.runner import stop_on_signals
 
 #: The parent's node name (its /diagnostics statuses are ``attitude_fleet: worker k``).
 NODE_NAME = 'attitude_fleet'
@@ -73,6 +74,15 @@ def shared_frames(frames, logger):
             '/tf, which would mix them; give each its own body_frame '
             '(key /<name>/attitude_simulator) to get TF')
     return shared
+
+
+def one_clock_source(clocks):
+    """Refuse (ConfigurationError) a fleet where more than one body (``clocks``) has /clock."""
+    if len(clocks) > 1:
+        raise ConfigurationError(
+            f'publish_clock is set for {len(clocks)} bodies ({", ".join(clocks[:3])}'
+            f'{", ..." if len(clocks) > 3 else ""}); /clock must have one source, so '
+            'set it for one body only (key /<name>/attitude_simulator)')
 
 
 def worker_report(fd, clocks, frames):
@@ -208,12 +218,7 @@ class Supervisor:
                             f'exited with {describe(code)} before its bodies started')
         if self.stop.is_set():
             return
-        clocks = [n for w in self.workers for n in w.report['clocks']]
-        if len(clocks) > 1:
-            raise ConfigurationError(
-                f'publish_clock is set for {len(clocks)} bodies ({", ".join(clocks[:3])}'
-                f'{", ..." if len(clocks) > 3 else ""}); /clock must have one source, so '
-                'set it for one body only (key /<name>/attitude_simulator)')
+        one_clock_source([n for w in self.workers for n in w.report['clocks']])
         frames = {ns: pair for w in self.workers for ns, pair in w.report['frames'].items()}
         go = json.dumps({'no_tf': shared_frames(frames, self.logger)})
         for worker in self.workers:
@@ -281,11 +286,7 @@ def supervise(groups, argv, early=None):
     configuration (the reason is logged) or a worker died or failed (each is logged and
     was on /diagnostics).
     """
-    stop = threading.Event()
-    previous = {sig: signal.signal(sig, lambda *_: stop.set())
-                for sig in (signal.SIGINT, signal.SIGTERM)}
-    if early:
-        stop.set()
+    stop, restore = stop_on_signals(early)
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     supervisor, code = None, 0
     try:
@@ -301,6 +302,5 @@ def supervise(groups, argv, early=None):
         if supervisor is not None:
             code = max(code, supervisor.finish())
         rclpy.try_shutdown()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        restore()
     return code

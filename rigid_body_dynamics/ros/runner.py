@@ -69,6 +69,24 @@ def _spin(nodes, stop):
         raise failure[0]
 
 
+def stop_on_signals(early=None):
+    """
+    Make SIGINT / SIGTERM set the returned Event (set already if ``early`` holds a signal).
+
+    Returns (stop, restore): ``restore()`` puts the previous handlers back.
+    """
+    stop = threading.Event()
+    previous = {sig: signal.signal(sig, lambda *_: stop.set())
+                for sig in (signal.SIGINT, signal.SIGTERM)}
+    if early:
+        stop.set()
+
+    def restore():
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    return stop, restore
+
+
 def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
     """
     Create the node with ``make_node()`` and spin it until SIGINT / SIGTERM.
@@ -81,11 +99,7 @@ def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
     code: 0, or 1 when the node refused its configuration (the reason is
     logged).
     """
-    stop = threading.Event()
-    previous = {sig: signal.signal(sig, lambda *_: stop.set())
-                for sig in (signal.SIGINT, signal.SIGTERM)}
-    if early:
-        stop.set()
+    stop, restore = stop_on_signals(early)
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     code = 0
@@ -109,6 +123,5 @@ def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
             for each in getattr(node, 'nodes', [node]):
                 each.destroy_node()
         rclpy.try_shutdown()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        restore()
     return code
