@@ -96,9 +96,9 @@ def cpu_seconds(pid):
 class Process:
     """A node process with its output in a temporary file; SIGINT on close."""
 
-    def __init__(self, cmd):
+    def __init__(self, cmd, env=None):
         self.log = tempfile.TemporaryFile()
-        self.proc = subprocess.Popen(cmd, stdout=self.log, stderr=subprocess.STDOUT)
+        self.proc = subprocess.Popen(cmd, stdout=self.log, stderr=subprocess.STDOUT, env=env)
 
     def close(self):
         """Stop with SIGINT (kill after 10 s)."""

@@ -14,14 +14,22 @@ restarted at every 10 ms hold (``physics.dynamics.reference.gyrostat_zoh_referen
 No friction and no limits (Basilisk's friction model differs). Errors are the largest
 over the holds: attitude (rad), omega relative to the run's largest |omega|, wheel speeds
 relative to the largest speed. Cost is wall time per simulated second, the least of three
-runs. Ours: the gyrostat integrator (``exact``: DOP853's order-8 formula at the fixed
-step; ``rk4``). Basilisk 2.12.1: a spacecraft hub with ``reactionWheelStateEffector``
-(BalancedWheels, wheels at the hub's centre of mass), the hub's inertia I itself: with
-BalancedWheels Basilisk takes the hub's inertia as the whole body's with the wheels locked,
-as this package does (measured: taking each wheel's Js g g^T + Jt (1 - g g^T) out of the
-hub made Basilisk differ from the reference by 0.2 rad in 2 s at every step and method, with
-I unchanged it agrees to 3e-15). RK4 and RKF78 at the same step, the motor torques
-written to the effector's command message before each hold.
+runs. Ours: the gyrostat integrator (``exact``: Butcher's order-6 formula, or DOP853's
+order-8 one when the body's fastest rate times the step exceeds 0.01; ``rk4``). Basilisk
+2.12.1: a spacecraft hub with ``reactionWheelStateEffector`` (BalancedWheels, wheels at the
+hub's centre of mass), the hub's inertia I itself: with BalancedWheels Basilisk takes the
+hub's inertia as the whole body's with the wheels locked, as this package does (measured:
+taking each wheel's Js g g^T + Jt (1 - g g^T) out of the hub made Basilisk differ from the
+reference by 0.2 rad in 2 s at every step and method, with I unchanged it agrees to 3e-15).
+RK4 and RKF78 at the same step, the motor torques written to the effector's command message
+before each hold.
+
+Then the step's cost beside the plain body's: microseconds per 1 ms step (the least of
+five runs of 2000 steps) of the plain body's ``exact`` under a held body torque, and of
+the gyrostat with the four pyramid wheels (J = 0.01 kg m^2, speeds (40, -25, 10, 0.5)
+rad/s, motor torques (0.01, -0.02, 0.005, 0) N m) without external torque and under the
+same held torque, without and with friction (wheels.yaml's Coulomb 1e-4 N m and viscous
+1e-6 N m s); the asymmetric body I = (1, 2, 3) kg m^2, omega0 = (0.3, 1.5, -0.4) rad/s.
 ``./dev bench --only wheels`` (Basilisk installed: ``pip install bsk==2.12.1``).
 """
 
@@ -33,6 +41,7 @@ import numpy as np
 from rigid_body_dynamics.physics import quaternions
 from rigid_body_dynamics.physics.control import QuaternionPD, WheelAllocator
 from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator, Wheels
+from rigid_body_dynamics.physics.dynamics.integrators import make_integrator
 from rigid_body_dynamics.physics.dynamics.reference import gyrostat_zoh_reference
 
 HOLD = 0.01
@@ -153,8 +162,46 @@ def _errors(ref, qs, ws, ss):
     return attitude, omega, speeds
 
 
+#: The step-cost case: body, wheels' speeds and motor torques, the held external torque.
+STEP_MOMENTS, STEP_OMEGA = (1.0, 2.0, 3.0), (0.3, 1.5, -0.4)
+STEP_SPEEDS, STEP_MOTORS = (40.0, -25.0, 10.0, 0.5), (0.01, -0.02, 0.005, 0.0)
+STEP_TORQUE = (0.01, -0.02, 0.005)
+
+
+def _us_per_step(stepper, torque, steps=2000, repeats=5):
+    """Return the least wall time (us) of one ``stepper.step(torque)`` over ``repeats`` runs."""
+    best = math.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(steps):
+            stepper.step(torque)
+        best = min(best, (time.perf_counter() - start) / steps)
+    return best * 1e6
+
+
+def step_cost():
+    """Return the lines of the step-cost table (see the module docstring)."""
+    plain = _us_per_step(make_integrator('exact', STEP_MOMENTS, 1e-3, omega0=STEP_OMEGA),
+                         STEP_TORQUE)
+    rows = [f'| plain body `exact` | held body torque | {plain:.1f} | 1.00 |']
+    for friction in (False, True):
+        wheels = Wheels(_PYRAMID, (0.01,) * 4, coulomb=(1e-4,) * 4 if friction else None,
+                        viscous=(1e-6,) * 4 if friction else None)
+        for torque in ((0.0, 0.0, 0.0), STEP_TORQUE):
+            body = GyrostatIntegrator(STEP_MOMENTS, wheels, 1e-3, omega0=STEP_OMEGA,
+                                      speeds0=STEP_SPEEDS)
+            body.command_motors(STEP_MOTORS)
+            cost = _us_per_step(body, torque)
+            rows.append(f'| four wheels{", friction" if friction else ""} `exact` | '
+                        f'{"held body torque" if any(torque) else "none"} | {cost:.1f} | '
+                        f'{cost / plain:.2f} |')
+    return ['### The step beside the plain body', '',
+            '| body | external torque | us per 1 ms step | / plain body under torque |',
+            '|---|---|---|---|'] + rows + ['']
+
+
 def measure(progress=print):
-    """Return RESULTS.md lines: one table per case, ours and Basilisk's."""
+    """Return RESULTS.md lines: one table per case, ours and Basilisk's; the step's cost."""
     lines = []
     for case, (moments, wheels, omega0, speeds0, factory) in CASES.items():
         progress(f'wheels {case}: reference ...')
@@ -181,7 +228,8 @@ def measure(progress=print):
         lines += [f'### {case}', '', '| method | dt (ms) | attitude error (rad) | omega error '
                   '(rel.) | wheel speed error (rel.) | ms per simulated s |',
                   '|---|---|---|---|---|---|'] + rows + ['']
-    return lines
+    progress('wheels: the step beside the plain body')
+    return lines + step_cost()
 
 
 if __name__ == '__main__':

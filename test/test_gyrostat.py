@@ -8,10 +8,13 @@ axisymmetric precession and the viscous spin-down; the linear stability theory f
 spin with rotor momentum. Tolerances are stated at each assertion.
 """
 
+import functools
 import math
+from unittest import mock
 
 import numpy as np
 import pytest
+from rigid_body_dynamics.physics.dynamics import gyrostat, gyrostat_kernels
 from rigid_body_dynamics.physics.dynamics.gyrostat import (GyrostatIntegrator,
                                                            precession_rate, spin_stability,
                                                            Wheels)
@@ -52,6 +55,55 @@ def test_motor_torques_friction_and_external_torque_against_dop853(method, dt, t
     assert np.abs(np.array(stepper.q) - y[3:7] / np.linalg.norm(y[3:7])).max() < tol
     assert np.abs(np.array(stepper.speeds) - y[7:11]).max() / np.abs(speeds0).max() < tol
     assert np.abs(np.array(stepper.angles) - y[11:]).max() / 100.0 < tol
+
+
+@pytest.mark.parametrize('dt,order,substeps', [(1e-3, 6, 1), (5e-3, 8, 1), (2e-2, 8, 3)])
+def test_the_order_and_sub_steps_follow_the_rate_and_stay_at_round_off(dt, order, substeps):
+    """
+    Fast wheels (|h_w| = 5.7 kg m^2/s, rho 7.7-8.4 1/s): order 6, 8, 8 in 2-3 sub-steps.
+
+    Each against DOP853 (rtol 1e-13) over 3 s to 1e-12, as the order-8 formula at
+    every step.
+    """
+    moments, wheels = (1.0, 2.0, 3.0), Wheels(((1, 0, 0), (0, 1, 0), (0, 0, 1)), (0.05,) * 3)
+    omega0, speeds0, u = (0.3, 1.5, -0.4), (100.0, -50.0, 20.0), (0.01, -0.02, 0.005)
+    stepper = GyrostatIntegrator(moments, wheels, dt, omega0=omega0, speeds0=speeds0)
+    stepper.command_motors(u)
+    used = []
+    kernel = functools.partial(gyrostat_kernels.kernel, n=3, friction=False)
+
+    def spy(order, n, mode, friction):
+        used.append(order)
+        step = kernel(order, mode=mode)
+        return lambda *args: (used.append('call'), step(*args))[1]
+    with mock.patch.object(gyrostat, 'kernel', spy):
+        for _ in range(int(round(3.0 / dt))):
+            stepper.step((0.02, 0.0, -0.01))
+    steps = int(round(3.0 / dt))
+    # rho h = 0.0077-0.0084, 0.038-0.042, 0.153-0.169: 2 sub-steps of order 8, 3 from 0.16
+    assert {u for u in used if u != 'call'} == {order}
+    assert (substeps == 1 and used.count('call') == steps) or \
+        steps * 2 < used.count('call') < steps * substeps
+    y = reference(moments, wheels, np.concatenate([omega0, (0, 0, 0, 1), speeds0, np.zeros(3)]),
+                  3.0, u, (0.02, 0.0, -0.01))
+    assert np.abs(np.array(stepper.omega) - y[:3]).max() / np.abs(y[:3]).max() < 1e-12
+    assert np.abs(np.array(stepper.q) - y[3:7] / np.linalg.norm(y[3:7])).max() < 1e-12
+    assert np.abs(np.array(stepper.speeds) - y[7:10]).max() / 100.0 < 1e-12
+
+
+def test_a_bad_torque_is_refused_and_changes_nothing():
+    """NaN, inf or a wrong length: ValueError with the reason, the state as it was."""
+    stepper = GyrostatIntegrator((1.0, 2.0, 3.0), Wheels(PYRAMID, (0.02,) * 4), 1e-3,
+                                 omega0=(0.3, 1.5, -0.4), speeds0=(40.0, -25.0, 10.0, 0.5))
+    stepper.step((0.01, 0.0, 0.0))
+    before = (stepper.q, stepper.omega, stepper.speeds, stepper.angles, stepper.steps,
+              stepper.work, stepper.impulse)
+    for torque, world in (((math.nan, 0.0, 0.0), None), ((0.0, 0.0), None),
+                          ((0.0, 0.0, 0.0), (0.0, math.inf, 0.0))):
+        with pytest.raises(ValueError, match='torque'):
+            stepper.step(torque, world)
+    assert (stepper.q, stepper.omega, stepper.speeds, stepper.angles, stepper.steps,
+            stepper.work, stepper.impulse) == before
 
 
 def test_the_balances_hold_to_round_off_torque_free_and_under_torque():

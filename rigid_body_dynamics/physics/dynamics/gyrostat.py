@@ -24,19 +24,24 @@ at every step (a wheel at rest under a fixed step would chatter between +c and -
 beyond 20 FRICTION_SMOOTHING it equals c sign(Omega) to double precision.
 
 :class:`GyrostatIntegrator` integrates the augmented state (omega, q, Omega, wheel
-angles) with an explicit Runge-Kutta formula of fixed step: DOP853's order-8 weights
-(``exact``: the torque-free gyrostat has no closed form here) or the classic RK4
-(``rk4``), the motor command held over each step. It books the work of the external
-torque, the motor work, the friction loss and the external impulse (world frame) by
-the same formula's quadrature of their rates, so T - T0 = W_ext + W_motor - W_friction
-and H_w - H_w0 = impulse check the accuracy (tests: to round-off against a tight
-DOP853).
+angles) with an explicit Runge-Kutta formula of fixed step, unrolled for the wheel
+count by :mod:`.gyrostat_kernels`: ``exact`` takes Butcher's order-6 formula while
+the body's fastest rate rho (|omega| + |sum J Omega g| / lambda_min(A) + sqrt(largest
+torque / lambda_min(A)), 1/s, A = I - sum J g g^T) times dt is at most
+``ORDER6_LIMIT``, else DOP853's order-8 formula in sub-steps with rho h <=
+``ORDER8_LIMIT`` (the torque-free gyrostat has no closed form here; the limits are the
+plain body's, :class:`~.integrators.ExactIntegrator`); ``rk4`` the classic RK4. The
+motor command is held over each step. It books the work of the external torque, the
+motor work, the friction loss and the external impulse (world frame) by the same
+formula's quadrature of their rates, so T - T0 = W_ext + W_motor - W_friction and
+H_w - H_w0 = impulse check the accuracy (tests: to round-off against a tight DOP853).
 """
 
 from dataclasses import dataclass
 import math
 
-from . import dop853_tableau
+from .gyrostat_kernels import constants, kernel
+from .integrators import as_torque, ExactIntegrator
 from ..quaternions import rotate_components
 
 _ZERO = (0.0, 0.0, 0.0)
@@ -47,9 +52,7 @@ MAX_WHEELS = 6
 #: How far a wheel axis may be from unit length (it is then normalised exactly).
 AXIS_TOLERANCE = 1e-6
 
-_RK4 = ((0.0, 0.5, 0.5, 1.0), (1 / 6, 1 / 3, 1 / 3, 1 / 6),
-        ((), (0.5,), (0.0, 0.5), (0.0, 0.0, 1.0)))
-_TABLEAUX = {'exact': (dop853_tableau.C, dop853_tableau.B, dop853_tableau.A), 'rk4': _RK4}
+_METHODS = ('exact', 'rk4')
 
 
 def _numbers(values, n, what, positive=False):
@@ -151,20 +154,6 @@ class Wheels:
                      for omega, c, v in zip(speeds, self.coulomb, self.viscous))
 
 
-def _inverse3(m):
-    """Inverse of a symmetric positive-definite 3x3 matrix (nested tuples), or ValueError."""
-    (a, b, c), (_, e, f), (_, _, i) = m
-    co = (e * i - f * f, c * f - b * i, b * f - c * e,
-          a * i - c * c, b * c - a * f, a * e - b * b)
-    det = a * co[0] + b * co[1] + c * co[2]
-    if not (det > 0.0 and a > 0.0 and a * e - b * b > 0.0):
-        raise ValueError('the body without its wheels spinning has no positive-definite '
-                         'inertia (I - sum J g g^T): the wheels are too heavy for the body')
-    return ((co[0] / det, co[1] / det, co[2] / det),
-            (co[1] / det, co[3] / det, co[4] / det),
-            (co[2] / det, co[4] / det, co[5] / det))
-
-
 class GyrostatIntegrator:
     """
     Fixed-step integrator of a gyrostat in the principal frame of its inertia.
@@ -183,6 +172,8 @@ class GyrostatIntegrator:
     """
 
     name = 'gyrostat'
+    ORDER6_LIMIT = ExactIntegrator.ORDER6_LIMIT
+    ORDER8_LIMIT = ExactIntegrator.ORDER8_LIMIT
 
     def __init__(self, moments, wheels, dt, q0=(0.0, 0.0, 0.0, 1.0), omega0=(0.0, 0.0, 0.0),
                  speeds0=None, method='exact'):
@@ -190,19 +181,16 @@ class GyrostatIntegrator:
         self.wheels = wheels
         if not (dt > 0.0 and math.isfinite(dt)):
             raise ValueError(f'dt must be positive and finite, got {dt!r}')
-        if method not in _TABLEAUX:
+        if method not in _METHODS:
             raise ValueError(f'unknown method {method!r} (exact or rk4)')
         self.dt, self.method = float(dt), method
-        self._c, self._b, self._a = _TABLEAUX[method]
-        locked = [[self.moments[r] if r == k else 0.0 for k in range(3)] for r in range(3)]
-        for g, j in zip(wheels.axes, wheels.inertia):
-            for r in range(3):
-                for k in range(3):
-                    locked[r][k] -= j * g[r] * g[k]
-        self._a_inv = _inverse3(tuple(tuple(row) for row in locked))
         # (the step's hot path: no tanh per wheel and stage for wheels without friction)
-        self._friction = wheels.friction if any(wheels.coulomb) or any(wheels.viscous) \
-            else (lambda speeds, zeros=(0.0,) * wheels.count: zeros)
+        self._friction = any(wheels.coulomb) or any(wheels.viscous)
+        self._k, self._a_min = constants(self.moments, wheels, self._friction,
+                                         FRICTION_SMOOTHING)
+        self._order6_rate = self.ORDER6_LIMIT / self.dt   # rho (1/s) up to which order 6
+        self._jg = tuple(tuple(j * c for c in g) for j, g in zip(wheels.inertia, wheels.axes))
+        self._kernels = {}          # (order, mode) -> the compiled step for these wheels
         self.commanded = (0.0,) * wheels.count
         self.reset(q0, omega0, speeds0)
 
@@ -272,106 +260,78 @@ class GyrostatIntegrator:
             t += j * s * (g[0] * w[0] + g[1] * w[1] + g[2] * w[2]) + 0.5 * j * s * s
         return t
 
-    def _rates(self, t, y, torque, torque_world, field, applied):
+    def _rate(self, torque, torque_world, field, applied):
         """
-        Return the derivatives of the state y and of the booked balances at time t.
+        Return rho (1/s), the body's fastest rate at the start of the step.
 
-        y = [omega (3), q (4), speeds (n), angles (n)]; returns (dy, (work rate,
-        motor power, friction power, world torque (3))).
+        |omega| + |sum J Omega g| / lambda_min(A) + sqrt(largest torque / lambda_min(A)),
+        the largest torque the sum of the largest external components and of the motor
+        torques' sizes (N m).
         """
-        w1, w2, w3, qx, qy, qz, qw = y[:7]
-        n = self.wheels.count
-        speeds = y[7:7 + n]
-        tx, ty, tz = torque
+        wx, wy, wz = self.omega
+        hx = hy = hz = 0.0
+        for (jx, jy, jz), s in zip(self._jg, self.speeds):
+            hx, hy, hz = hx + jx * s, hy + jy * s, hz + jz * s
+        largest = max(abs(torque[0]), abs(torque[1]), abs(torque[2])) + sum(map(abs, applied))
         if torque_world is not None:
-            a = rotate_components((-qx, -qy, -qz, qw), torque_world)
-            tx, ty, tz = tx + a[0], ty + a[1], tz + a[2]
+            largest += max(abs(torque_world[0]), abs(torque_world[1]), abs(torque_world[2]))
         if field is not None:
-            f = field(t, qx, qy, qz, qw, w1, w2, w3)
-            tx, ty, tz = tx + f[0], ty + f[1], tz + f[2]
-        i1, i2, i3 = self.moments
-        hx, hy, hz = i1 * w1, i2 * w2, i3 * w3
-        rx, ry, rz = tx, ty, tz
-        friction = self._friction(speeds)
-        nets, motor, loss = [], 0.0, 0.0
-        for (gx, gy, gz), j, s, u, fr in zip(self.wheels.axes, self.wheels.inertia, speeds,
-                                             applied, friction):
-            hx, hy, hz = hx + j * s * gx, hy + j * s * gy, hz + j * s * gz
-            net = u - fr
-            rx, ry, rz = rx - gx * net, ry - gy * net, rz - gz * net
-            nets.append(net)
-            motor += s * u
-            loss += s * fr
-        rx -= w2 * hz - w3 * hy
-        ry -= w3 * hx - w1 * hz
-        rz -= w1 * hy - w2 * hx
-        (a11, a12, a13), (a21, a22, a23), (a31, a32, a33) = self._a_inv
-        d1 = a11 * rx + a12 * ry + a13 * rz
-        d2 = a21 * rx + a22 * ry + a23 * rz
-        d3 = a31 * rx + a32 * ry + a33 * rz
-        dy = [d1, d2, d3,
-              0.5 * (qw * w1 + qy * w3 - qz * w2), 0.5 * (qw * w2 + qz * w1 - qx * w3),
-              0.5 * (qw * w3 + qx * w2 - qy * w1), -0.5 * (qx * w1 + qy * w2 + qz * w3)]
-        dy += [net / j - (g[0] * d1 + g[1] * d2 + g[2] * d3)
-               for net, j, g in zip(nets, self.wheels.inertia, self.wheels.axes)]
-        dy += list(speeds)
-        world = rotate_components((qx, qy, qz, qw), (tx, ty, tz)) if tx or ty or tz else _ZERO
-        return dy, (w1 * tx + w2 * ty + w3 * tz, motor, loss, world)
+            f = field(self.time, *self.q, wx, wy, wz)
+            largest += max(abs(f[0]), abs(f[1]), abs(f[2]))
+        return (math.sqrt(wx * wx + wy * wy + wz * wz)
+                + math.sqrt(hx * hx + hy * hy + hz * hz) / self._a_min
+                + math.sqrt(largest / self._a_min))
 
-    def step(self, torque=(0.0, 0.0, 0.0), torque_world=None, field=None):
+    def step(self, torque=_ZERO, torque_world=None, field=None):
         """
         Advance by dt, the motor command limited now and held over the step.
 
         ``torque``: external body torque (N m, principal frame), held;
         ``torque_world``: held in the world frame; ``field(t, qx, qy, qz, qw, wx, wy, wz)``: a
-        principal-frame torque evaluated at the stages.
+        principal-frame torque evaluated at the stages. A torque that is not three finite
+        numbers raises ValueError and leaves the state as it was.
         """
-        torque = tuple(float(c) for c in torque)
-        if len(torque) != 3 or not all(math.isfinite(c) for c in torque):
-            raise ValueError(f'torque must be three finite numbers (N m), got {torque}')
+        torque = as_torque(torque, 'torque')
+        if torque_world is not None:
+            torque_world = as_torque(torque_world, 'torque_world')
+            if not (torque_world[0] or torque_world[1] or torque_world[2]):
+                torque_world = None
+        if field is not None:
+            mode, torque_world = 'field', torque_world or _ZERO
+        elif torque_world is not None:
+            mode = 'world'
+        else:
+            mode = 'body' if torque[0] or torque[1] or torque[2] else 'free'
         applied, clipped, cut = self.wheels.limit(self.commanded, self.speeds)
-        for i, (cl, ct) in enumerate(zip(clipped, cut)):
-            self.clipped[i] += cl
-            self.cut[i] += ct
+        if True in clipped or True in cut:
+            for i, (cl, ct) in enumerate(zip(clipped, cut)):
+                self.clipped[i] += cl
+                self.cut[i] += ct
         self.applied = applied
-        h, t0 = self.dt, self.time
-        y = list(self.omega) + list(self.q) + list(self.speeds) + list(self.angles)
-        ks, ps = [], []
-        for c, row in zip(self._c, self._a):
-            ys = y if not row else [v + d for v, d in zip(y, self._increment(row, ks))]
-            k, p = self._rates(t0 + c * h, ys, torque, torque_world, field, applied)
-            ks.append(k)
-            ps.append(p)
-        b = self._b
-        y = [v + d for v, d in zip(y, self._increment(b, ks))]
-        self.work += h * sum(bi * p[0] for bi, p in zip(b, ps) if bi)
-        self.motor_work += h * sum(bi * p[1] for bi, p in zip(b, ps) if bi)
-        self.friction_loss += h * sum(bi * p[2] for bi, p in zip(b, ps) if bi)
-        self.impulse = tuple(acc + h * sum(bi * p[3][m] for bi, p in zip(b, ps) if bi)
-                             for m, acc in enumerate(self.impulse))
-        n = self.wheels.count
-        q = y[3:7]
-        norm = math.sqrt(sum(c * c for c in q))
-        self.omega = tuple(y[:3])
-        self.q = tuple(c / norm for c in q)
-        self.speeds = tuple(y[7:7 + n])
-        self.angles = tuple(y[7 + n:])
+        order, count = 4, 1
+        if self.method == 'exact':
+            rho = self._rate(torque, torque_world, field, applied)
+            order = 6 if rho <= self._order6_rate else 8
+            if order == 8:
+                count = max(1, math.ceil(rho * self.dt / self.ORDER8_LIMIT))
+        step = self._kernels.get((order, mode))
+        if step is None:
+            step = self._kernels[order, mode] = kernel(order, self.wheels.count, mode,
+                                                       self._friction)
+        h, t0 = self.dt / count, self.time
+        q, w, speeds, angles = self.q, self.omega, self.speeds, self.angles
+        for i in range(count):
+            q, w, speeds, angles, work, motor, loss, impulse = step(
+                self._k, q, w, speeds, angles, h, applied, torque, torque_world, field,
+                t0 + i * h)
+            self.work += work
+            self.motor_work += motor
+            self.friction_loss += loss
+            if mode != 'free':
+                ix, iy, iz = self.impulse
+                self.impulse = (ix + impulse[0], iy + impulse[1], iz + impulse[2])
+        self.q, self.omega, self.speeds, self.angles = q, w, speeds, angles
         self.steps += 1
-
-    def _increment(self, weights, ks):
-        """
-        Return h sum_j w_j k_j, summed term by term apart from the state.
-
-        (Adding each term to the state instead loses its low bits at every term: the
-        errors against DOP853 grew 3-5 times.)
-        """
-        h, out = self.dt, None
-        for w, k in zip(weights, ks):
-            if w:
-                hw = h * w
-                out = [hw * kv for kv in k] if out is None else \
-                    [o + hw * kv for o, kv in zip(out, k)]
-        return out
 
     def free_steps(self, count):
         """Advance ``count`` steps without external torque (the wheels still act)."""

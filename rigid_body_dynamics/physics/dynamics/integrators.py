@@ -66,7 +66,7 @@ def rk_constants(moments):
     return ((i2 - i3) / i1, (i3 - i1) / i2, (i1 - i2) / i3, 1.0 / i1, 1.0 / i2, 1.0 / i3)
 
 
-def _as_torque(value, what):
+def as_torque(value, what):
     """Return ``value`` as a 3-tuple of finite floats (N m), or raise ValueError saying why."""
     if value.__class__ is not tuple or len(value) != 3:
         try:
@@ -171,9 +171,9 @@ class Integrator(ABC):
         A torque that is not three finite numbers raises ValueError and
         leaves the state as it was.
         """
-        torque = _as_torque(torque, 'torque')
+        torque = as_torque(torque, 'torque')
         if torque_world is not None:
-            torque_world = _as_torque(torque_world, 'torque_world')
+            torque_world = as_torque(torque_world, 'torque_world')
             if not (torque_world[0] or torque_world[1] or torque_world[2]):
                 torque_world = None
         if field is None and torque_world is None and not (torque[0] or torque[1] or torque[2]):

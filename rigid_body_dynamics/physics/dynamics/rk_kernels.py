@@ -63,7 +63,8 @@ _OMEGA = ('wx', 'wy', 'wz')
 _QUAT = ('qx', 'qy', 'qz', 'qw')
 
 
-def _lit(coefficient):
+def literal(coefficient):
+    """Return a coefficient as a float literal of the generated source."""
     return repr(float(coefficient))
 
 
@@ -73,7 +74,7 @@ def _derivative_lines(i, mode, node):
     fx, fy, fz = (' + fx', ' + fy', ' + fz') if mode == 'field' else ('', '', '')
     lines = []
     if mode == 'field':
-        lines.append(f'    fx, fy, fz = field(t + {_lit(node)} * h, {qx}, {qy}, {qz}, {qw}, '
+        lines.append(f'    fx, fy, fz = field(t + {literal(node)} * h, {qx}, {qy}, {qz}, {qw}, '
                      f'{wx}, {wy}, {wz})')
     if mode in ('world', 'field'):
         # tau_b = tau + R(q)^T tau_world: rotate by the conjugate (-qx, -qy, -qz, qw)
@@ -125,13 +126,14 @@ def kernel_source(tableau, mode, name='step'):
     for i, row in enumerate(rows):
         if i > 0:
             for var in _OMEGA + _QUAT:
-                terms = ' + '.join(f'{_lit(a)} * d{var}{j}' for j, a in enumerate(row) if a != 0)
+                terms = ' + '.join(f'{literal(a)} * d{var}{j}'
+                                   for j, a in enumerate(row) if a != 0)
                 lines.append(f'    {var}{i} = {var}0 + {terms}' if terms else
                              f'    {var}{i} = {var}0')
         lines += _derivative_lines(i, mode, nodes[i])
     used = [(j, b) for j, b in enumerate(weights) if b != 0]
     for var in _OMEGA + _QUAT:
-        terms = ' + '.join(f'{_lit(b)} * d{var}{j}' for j, b in used)
+        terms = ' + '.join(f'{literal(b)} * d{var}{j}' for j, b in used)
         lines.append(f'    {var} = {var}0 + ({terms})')
     lines.append('    r = (qx * qx + qy * qy + qz * qz + qw * qw) ** -0.5')
     if mode == 'free':
@@ -139,24 +141,33 @@ def kernel_source(tableau, mode, name='step'):
     else:
         # work = h sum_i b_i omega_i . tau_i
         if mode == 'body':
-            power = [f'{_lit(b)} * (wx{j} * tbx + wy{j} * tby + wz{j} * tbz)' for j, b in used]
+            power = [f'{literal(b)} * (wx{j} * tbx + wy{j} * tby + wz{j} * tbz)' for j, b in used]
         else:
-            power = [f'{_lit(b)} * (wx{j} * tx{j} + wy{j} * ty{j} + wz{j} * tz{j})'
+            power = [f'{literal(b)} * (wx{j} * tx{j} + wy{j} * ty{j} + wz{j} * tz{j})'
                      for j, b in used]
         lines.append('    work = h * (' + ' + '.join(power) + ')')
     lines.append('    return (qx * r, qy * r, qz * r, qw * r), (wx, wy, wz), work')
     return '\n'.join(lines) + '\n'
 
 
-def compile_kernel(tableau, mode, label=''):
-    """Compile :func:`kernel_source` into a function; its source goes to linecache."""
-    source = kernel_source(tableau, mode)
-    filename = f'<rk kernel {label} {mode}>'
+def compile_source(source, filename, namespace=None):
+    """
+    Compile generated ``source`` and return its one function.
+
+    The source goes to :mod:`linecache` under ``filename`` so that a traceback shows
+    the generated statement; ``namespace`` holds the names the source uses (e.g. tanh).
+    """
     # (size, mtime None: never checked against a file, lines, name), as for code without a file
     linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
-    namespace = {}
+    namespace = dict(namespace or {})
     exec(compile(source, filename, 'exec'), namespace)  # noqa: S102 (generated from a tableau)
-    return namespace['step']
+    name = source.split('(', 1)[0].split()[-1]
+    return namespace[name]
+
+
+def compile_kernel(tableau, mode, label=''):
+    """Compile :func:`kernel_source` into a function; its source goes to linecache."""
+    return compile_source(kernel_source(tableau, mode), f'<rk kernel {label} {mode}>')
 
 
 #: Kernels by (order, mode).
