@@ -123,7 +123,8 @@ ASYMMETRIC_SETUPS = (
 )
 
 
-def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128, 160)):
+def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128, 160),
+                       setups=ASYMMETRIC_SETUPS):
     """
     Fleets of asymmetric bodies: what limits the count, what to switch off.
 
@@ -137,7 +138,7 @@ def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128, 160)):
              'real time |', '|---|---|---|---|---|---|---|---|']
     best = {}
     try:
-        for label, way, extra in ASYMMETRIC_SETUPS:
+        for label, way, extra in setups:
             failures = 0
             for n in counts:
                 cpu, missed, slowest, why = run_bodies(probe, way, n, window, ASYMMETRIC + extra)
@@ -154,5 +155,5 @@ def measure_asymmetric(window=8.0, counts=(32, 48, 64, 96, 128, 160)):
     finally:
         probe.close()
     summary = '; '.join(f'{label}, {way.split(", ")[-1]}: {best.get((label, way), 0)}'
-                        for label, way, _ in ASYMMETRIC_SETUPS)
+                        for label, way, _ in setups)
     return lines + ['', f'Most asymmetric bodies in real time: {summary}.']

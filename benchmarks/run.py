@@ -8,7 +8,8 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 ``--only nodes`` skips the physics sections; ``--only torque`` runs the
 torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak |
 soak-rt | flood | bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep |
-latency | publish | flow-batch | estimation | discovery``
+latency | publish | flow-batch | estimation | discovery | late-steps |
+bodies-wheels``
 runs one reliability / scale measurement (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
@@ -52,7 +53,7 @@ def main():
                                            'publish', 'flow-batch', 'command-path',
                                            'simulate-cost', 'wheels', 'wheels-node',
                                            'environment', 'environment-node', 'estimation',
-                                           'discovery'],
+                                           'discovery', 'late-steps', 'bodies-wheels'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -120,6 +121,8 @@ SCALE = {
     'environment-node': ('environment_node', 'attitude_simulator in orbit: CPU'),
     'estimation': ('estimation', "The estimator's sensors and the example MEKF"),
     'discovery': ('discovery', 'DDS discovery time and the number of participants'),
+    'bodies-wheels': ('bodies_wheels', 'Many bodies with reaction wheels in fleets'),
+    'late-steps': ('late_steps', 'Late steps in one fleet process, and what they waited for'),
 }
 
 

@@ -135,6 +135,9 @@ class Wheels:
         to the body). Basilisk's order: clip |u| to max_torque, then cut u to 0 where
         |Omega| >= max_speed and Omega u > 0. Returns (applied, clipped, cut).
         """
+        if not any(commanded):           # nothing to clip, nothing to cut off
+            none = (False,) * len(commanded)
+            return tuple(commanded), none, none
         applied, clipped, cut = [], [], []
         for u, omega, top, fastest in zip(commanded, speeds, self.max_torque, self.max_speed):
             clip = top > 0.0 and abs(u) > top

@@ -1,0 +1,25 @@
+"""
+Fleets of asymmetric bodies with four reaction wheels each: how many run in real time.
+
+attitude_fleet with the asymmetric body of the bodies sweeps (I = (1, 2, 3) kg m^2, omega0 =
+(0.3, 1.5, -0.4) rad/s) carrying ``doc/examples/wheels.yaml``'s four pyramid wheels (with
+their friction, motors at 0), at the defaults (1 kHz steps, 7 state topics and the imu at
+100 Hz, wheel_state at the publish rate), in one process and over two. Every step of a body
+with wheels is a Runge-Kutta step of the gyrostat (there is no closed-form flow to skip
+steps on). Same criterion as the bodies sweep. ``./dev bench --only bodies-wheels`` (about 8
+minutes).
+"""
+
+import os
+
+from bodies import measure_asymmetric, ONE, TWO
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+WHEELS = os.path.join(HERE, '..', 'doc', 'examples', 'wheels.yaml')
+SETUPS = (('four wheels (wheels.yaml), defaults', ONE, ('--params-file', WHEELS)),
+          ('four wheels (wheels.yaml), defaults', TWO, ('--params-file', WHEELS)))
+
+
+def measure():
+    """Run the sweep; Markdown lines."""
+    return measure_asymmetric(counts=(32, 48, 64, 96), setups=SETUPS)
