@@ -1,24 +1,27 @@
 """
-Late steps in one fleet process: what the integration thread was waiting for.
+Late steps in one fleet process: where the integration thread was when a body was late.
 
-attitude_fleet ``--processes 1`` with asymmetric bodies at the defaults (1 kHz steps, 7 state
-topics and the imu at 100 Hz), started through a probe that records, inside the fleet
-process, for a window after 5 s of warm-up:
+attitude_fleet ``--processes 1`` with asymmetric bodies at the defaults (I = (1, 2, 3) kg m^2,
+1 kHz steps, 7 state topics and the imu at 100 Hz), started through a probe that records,
+inside the fleet process, over 10 s after 5 s of warm-up:
 
 - every wake more than 5 ms after its deadline (a missed deadline of the diagnostics), with
-  the interval from the deadline to the wake;
+  the interval from the deadline to the wake (bodies of one phase group are late together:
+  "instants" counts the distinct milliseconds);
 - every garbage collection (its generation and duration, ``gc.callbacks``);
-- every pass of the integration thread's loop that took more than 1 ms, and every sleep that
-  ended more than 1 ms after it was meant to (the thread wanted to run and could not: the
-  GIL held by another thread, or no core).
+- every pass of the integration thread's loop that took more than 1 ms of wall time, with the
+  thread's own CPU time in it (``time.thread_time_ns``): wall minus CPU is the time the
+  thread was ready and did not run (another thread holding the GIL, or no core for it).
 
-A late wake is put down to a collection when one ran within its interval, else to a long
-pass, else to a late sleep. ``./dev bench --only late-steps`` (about 3 minutes).
+A late wake is put down to a collection when one ran within its interval, else to a pass
+off the CPU for more than 2 ms, else to a long pass on the CPU (integrating and publishing
+a group of bodies). Each count runs with normal scheduling and with the integration thread
+under SCHED_FIFO (``thread_priority``; the probe runs as root here). ``./dev bench --only
+late-steps`` (about 3 minutes).
 """
 
 import json
 import os
-import statistics
 import sys
 import tempfile
 import time
@@ -34,12 +37,11 @@ import gc, json, os, sys, threading, time
 from rigid_body_dynamics.engine import loop, pacer
 
 out, warmup, window = sys.argv.pop(1), float(sys.argv.pop(1)), float(sys.argv.pop(1))
-before = os.environ.get('LATE_STEPS_BEFORE') == '1'
-if before:                                   # the fleet as it was: no settling of the heap
+if os.environ.get('LATE_STEPS_NO_FREEZE') == '1':   # the fleet as before: nothing frozen
     from rigid_body_dynamics.ros import runner
     runner.settle_heap = lambda: None
 clock = time.monotonic_ns
-events = {'gc': [], 'late': [], 'long': [], 'oversleep': []}
+events = {'gc': [], 'late': [], 'long': [], 'executor': []}
 recording = threading.Event()
 started = {}
 
@@ -66,20 +68,59 @@ def recorded_due(self, outbox):
 
 pacer.Pace.due = recorded_due
 cycle = loop.Loop.cycle
-last = {}
+
+spent = {'due': 0, 'out': 0, 'items': 0}
+thread_time = time.thread_time_ns
 
 def recorded_cycle(self):
-    start = clock()
-    if 'until' in last and recording.is_set() and start - last['until'] > 1_000_000:
-        events['oversleep'].append((last['until'], start))
+    start, cpu = clock(), thread_time()
+    spent.update(due=0, out=0, items=0)
     wait = cycle(self)
     end = clock()
     if recording.is_set() and end - start > 1_000_000:
-        events['long'].append((start, end))
-    last['until'] = end + int(wait * 1e9) if wait > 0.0 else end
+        # (start, end, this thread's CPU in the pass, in Pace.due, in publishing, items)
+        events['long'].append((start, end, thread_time() - cpu, spent['due'], spent['out'],
+                               spent['items']))
     return wait
 
 loop.Loop.cycle = recorded_cycle
+due_timed = pacer.Pace.due
+
+def timed_due(self, outbox):
+    start = clock()
+    try:
+        return due_timed(self, outbox)
+    finally:
+        spent['due'] += clock() - start
+
+pacer.Pace.due = timed_due
+member_init = loop.Member.__init__
+
+def timed_member(self, pace, publish, *args, **kwargs):
+    def timed_publish(item):
+        start = clock()
+        try:
+            return publish(item)
+        finally:
+            spent['out'] += clock() - start
+            spent['items'] += 1
+    member_init(self, pace, timed_publish, *args, **kwargs)
+
+loop.Member.__init__ = timed_member
+
+from rclpy.executors import SingleThreadedExecutor
+spin_once = SingleThreadedExecutor.spin_once
+
+def recorded_spin_once(self, *args, **kwargs):
+    start = clock()
+    try:
+        return spin_once(self, *args, **kwargs)
+    finally:
+        end = clock()
+        if recording.is_set() and end - start > 1_000_000:
+            events['executor'].append((start, end))
+
+SingleThreadedExecutor.spin_once = recorded_spin_once
 
 def record():
     time.sleep(warmup)
@@ -90,6 +131,9 @@ def record():
     events['window'] = (t0, clock())
     events['objects'] = len(gc.get_objects())
     events['frozen'] = gc.get_freeze_count()
+    start = clock()
+    gc.collect()                    # what one full collection costs now (after the window)
+    events['full_ms'] = (clock() - start) / 1e6
     with open(out, 'w') as f:
         json.dump(events, f)
 
@@ -98,7 +142,7 @@ from rigid_body_dynamics.nodes.fleet import main
 sys.argv[0] = 'attitude_fleet'
 main()
 """
-COUNTS = (48, 64)
+COUNTS = (48,)
 WARMUP, WINDOW = 5.0, 10.0
 
 
@@ -107,14 +151,18 @@ def _overlaps(a, b, spans):
     return [s for s in spans if s[0] < b and s[1] > a]
 
 
-def run(n, before, warmup=WARMUP, window=WINDOW):
-    """Run ``n`` bodies with the probe; return its events (dict), or raise RuntimeError."""
+def run(n, extra=(), warmup=WARMUP, window=WINDOW, env=None, processes=True):
+    """
+    Run ``n`` bodies (``extra``: more --ros-args) with the probe; return its events (dict).
+
+    ``env``: the fleet's environment (default: this one's); ``processes`` False for a fleet
+    from before ``--processes`` (always one process).
+    """
     fd, out = tempfile.mkstemp(suffix='.json')
     os.close(fd)
     os.unlink(out)
-    env = dict(os.environ, LATE_STEPS_BEFORE='1' if before else '0')
     cmd = [sys.executable, '-c', PROBE, out, str(warmup), str(window), '--bodies', str(n),
-           '--processes', '1', '--ros-args', *ASYMMETRIC]
+           *(('--processes', '1') if processes else ()), '--ros-args', *ASYMMETRIC, *extra]
     proc = Process(cmd, env)
     try:
         deadline = time.monotonic() + warmup + window + 60.0 + n
@@ -131,46 +179,62 @@ def run(n, before, warmup=WARMUP, window=WINDOW):
             os.unlink(out)
 
 
+#: A pass that lost this long off the CPU (wall time minus the thread's CPU time, ns).
+OFF_CPU = 2_000_000
+
+
 def summarise(events):
     """Return a dict of counts and times (ms) from one run's events."""
-    late, gcs = events['late'], events['gc']
-    by_gc = by_long = by_sleep = 0
+    late, gcs, passes = events['late'], events['gc'], events['long']
+    off = [p for p in passes if (p[1] - p[0]) - p[2] > OFF_CPU]
+    long_gcs = [g[:2] for g in gcs if g[1] - g[0] > OFF_CPU]
+    by = dict.fromkeys(('gc', 'off', 'busy', 'other'), 0)
     for a, b in late:
-        if _overlaps(a, b, gcs):
-            by_gc += 1
-        elif _overlaps(a, b, events['long']):
-            by_long += 1
-        elif _overlaps(a, b, events['oversleep']):
-            by_sleep += 1
-    full = [(e - s) / 1e6 for s, e, g in gcs if g == 2]
-    young = [(e - s) / 1e6 for s, e, g in gcs if g < 2]
-    long_ms = [(e - s) / 1e6 for s, e in events['long']]
-    sleep_ms = [(e - s) / 1e6 for s, e in events['oversleep']]
-    return {'late': len(late), 'by_gc': by_gc, 'by_long': by_long, 'by_sleep': by_sleep,
-            'full': len(full), 'full_ms': max(full, default=0.0),
-            'young': len(young), 'young_ms': max(young, default=0.0),
-            'long': len(long_ms), 'long_ms': max(long_ms, default=0.0),
-            'sleep': len(sleep_ms), 'sleep_ms': max(sleep_ms, default=0.0),
-            'sleep_median': statistics.median(sleep_ms) if sleep_ms else 0.0,
-            'objects': events['objects'], 'frozen': events['frozen']}
+        if _overlaps(a, b, long_gcs):
+            by['gc'] += 1
+        elif _overlaps(a, b, [p[:2] for p in off]):
+            by['off'] += 1
+        elif _overlaps(a, b, [p[:2] for p in passes]):
+            by['busy'] += 1
+        else:
+            by['other'] += 1
+    return {'late': len(late), 'by': by,
+            'instants': len({round(a / 1e6) for a, _b in late}),
+            'full': sum(1 for g in gcs if g[2] == 2),
+            'gc_ms': max(((e - s) / 1e6 for s, e, _g in gcs), default=0.0),
+            'passes': len(passes),
+            'pass_ms': max(((p[1] - p[0]) / 1e6 for p in passes), default=0.0),
+            'cpu_ms': max((p[2] / 1e6 for p in passes), default=0.0),
+            'off': len(off),
+            'off_ms': max((((p[1] - p[0]) - p[2]) / 1e6 for p in passes), default=0.0),
+            'full_after_ms': events['full_ms'], 'objects': events['objects'],
+            'frozen': events['frozen']}
 
 
-def measure(counts=COUNTS):
-    """Before and after for each count; Markdown lines."""
-    lines = ['| bodies | heap | late wakes (> 5 ms) | during a collection / a long pass / '
-             'a late sleep | full collections (longest, ms) | young collections (longest, '
-             'ms) | passes > 1 ms (longest, ms) | sleeps > 1 ms late (median, longest, ms) | '
-             'objects tracked (frozen) |', '|---|---|---|---|---|---|---|---|---|']
+#: (label, environment of the probe): the fleet without and with gc.freeze after start-up.
+SETUPS = (('without gc.freeze (as before)', {'LATE_STEPS_NO_FREEZE': '1'}),
+          ('gc.freeze after start-up', {}))
+
+
+def measure(counts=COUNTS, rounds=2):
+    """Each count without and with the frozen start-up heap, alternating; Markdown lines."""
+    lines = ['| bodies | start-up heap | late wakes > 5 ms (instants) | in a collection > 2 ms / '
+             'in a pass off the CPU > 2 ms / in a long pass on it / other | full collections '
+             'in the window (longest collection, ms) | one full collection after it (ms) | '
+             'objects tracked (frozen) | passes > 1 ms (longest wall, longest CPU, ms) |',
+             '|---|---|---|---|---|---|---|---|']
     for n in counts:
-        for before in (True, False):
-            s = summarise(run(n, before))
-            lines.append(
-                f'| {n} | {"as before" if before else "settled"} | {s["late"]} | '
-                f'{s["by_gc"]} / {s["by_long"]} / {s["by_sleep"]} | '
-                f'{s["full"]} ({s["full_ms"]:.1f}) | {s["young"]} ({s["young_ms"]:.1f}) | '
-                f'{s["long"]} ({s["long_ms"]:.1f}) | {s["sleep"]} ({s["sleep_median"]:.1f}, '
-                f'{s["sleep_ms"]:.1f}) | {s["objects"]} ({s["frozen"]}) |')
-            print(lines[-1], flush=True)
+        for _ in range(rounds):
+            for label, env in SETUPS:
+                s = summarise(run(n, env=dict(os.environ, **env)))
+                by = s['by']
+                lines.append(
+                    f'| {n} | {label} | {s["late"]} ({s["instants"]}) | {by["gc"]} / '
+                    f'{by["off"]} / {by["busy"]} / {by["other"]} | {s["full"]} '
+                    f'({s["gc_ms"]:.1f}) | {s["full_after_ms"]:.1f} | {s["objects"]} '
+                    f'({s["frozen"]}) | {s["passes"]} ({s["pass_ms"]:.1f}, '
+                    f'{s["cpu_ms"]:.1f}) |')
+                print(lines[-1], flush=True)
     return lines
 
 

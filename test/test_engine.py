@@ -646,3 +646,32 @@ def test_lockstep_with_wheels_a_wheel_command_answers_the_tick():
         for _ in range(10):
             ref.step()
     assert body.stepper.q == ref.q and body.stepper.speeds == ref.speeds and lock.ticks == 3
+
+
+def test_the_start_up_heap_is_frozen_before_the_loop_starts():
+    """
+    runner.run freezes the objects start-up made (after one collection) before on_start.
+
+    In a fresh interpreter with the package's ROS modules imported: most tracked objects
+    are frozen after settle_heap(), and run() calls it between make_node() and on_start.
+    """
+    source = (
+        'import gc\n'
+        'from unittest import mock\n'
+        'from rigid_body_dynamics.ros import runner\n'
+        'before = len(gc.get_objects())\n'
+        'runner.settle_heap()\n'
+        'print(before, gc.get_freeze_count(), len(gc.get_objects()))\n'
+        'gc.unfreeze()\n'
+        'order = []\n'
+        'node = mock.Mock(nodes=[])\n'
+        'with mock.patch.object(runner, "rclpy"), mock.patch.object(runner, "_spin"), \\\n'
+        '        mock.patch.object(runner, "settle_heap", lambda: order.append("settle")):\n'
+        '    runner.run(lambda: order.append("make") or node, "n",\n'
+        '               on_start=lambda n: order.append("start"))\n'
+        'print(" ".join(order))\n')
+    out = subprocess.run([sys.executable, '-c', source], capture_output=True, text=True,
+                         timeout=120, check=True).stdout.split('\n')
+    before, frozen, after = (int(v) for v in out[0].split())
+    assert frozen > 0.8 * before and after < 0.2 * before
+    assert out[1] == 'make settle start'

@@ -9,6 +9,7 @@ checks it, then wakes the executor thread and waits for it, so shutdown always
 happens between callbacks.
 """
 
+import gc
 import signal
 import threading
 import time
@@ -87,6 +88,20 @@ def stop_on_signals(early=None):
     return stop, restore
 
 
+def settle_heap():
+    """
+    Collect once, then keep what start-up made out of every later collection (gc.freeze).
+
+    A full collection traverses every object the collector tracks, with every thread of
+    the process stopped: in a 48-body fleet (120 000 objects after start-up: modules,
+    nodes, message types) one took 70 ms, and every body's steps in it were late. The
+    objects made at start-up live as long as the process, so they are frozen after one
+    collection; later collections traverse only what was made since.
+    """
+    gc.collect()
+    gc.freeze()
+
+
 def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
     """
     Create the node with ``make_node()`` and spin it until SIGINT / SIGTERM.
@@ -107,6 +122,7 @@ def run(make_node, name, args=None, on_start=None, on_stop=None, early=None):
         if stop.is_set():
             return code
         node = make_node()
+        settle_heap()
         if on_start and not stop.is_set():
             on_start(node)
         _spin(getattr(node, 'nodes', [node]), stop)
