@@ -13,17 +13,12 @@ crossings, with torque-free segments on the exact flow). Cost is wall time per s
 second (least of five), also over a plain pure-Python RK4 at 1 ms (``torque.plain_rk4``,
 the unit the cost targets are stated in) measured in the same run. Accuracy: the largest
 attitude error (rad) at the 10 ms holds against scipy's DOP853 at rtol 2.5e-14
-(``zoh_reference``), in the principal frame. Measured for the working tree and, in a fresh
-interpreter, for the revision before the change (``command_path.BEFORE``, checked out into
-a temporary worktree).
-``./dev bench --only simulate-cost``.
+(``zoh_reference``), in the principal frame. (The comparison with the revision before the
+one command path, 68c4864, ended with the physics sub-packages, which its scripts predate:
+its figures are in this file's history.) ``./dev bench --only simulate-cost``.
 """
 
-import json
 import math
-import os
-import subprocess
-import sys
 import time
 
 from common import best_of, fmt
@@ -54,7 +49,7 @@ def _bodies():
 
 
 def _switched(t):
-    """The on-off schedule's sign at t (s): +1 before 3 s, -1 in [8, 11) s, else 0."""
+    """Return the on-off schedule's sign at t (s): +1 before 3 s, -1 in [8, 11) s, else 0."""
     return 1.0 if t < 3.0 else (-1.0 if 8.0 <= t < 11.0 else 0.0)
 
 
@@ -96,34 +91,15 @@ def rows():
 
 
 def measure():
-    """Return RESULTS.md lines: cost and accuracy of each variant, before and after."""
-    import command_path
-    old = command_path._tree(command_path.BEFORE)
-    try:
-        here = os.path.dirname(os.path.abspath(__file__))
-        child = subprocess.run([sys.executable, os.path.abspath(__file__), '--rows'],
-                               env=dict(os.environ, PYTHONPATH=old), cwd=here, check=True,
-                               capture_output=True, text=True, timeout=1200)
-        before_unit, before = json.loads(child.stdout.strip().splitlines()[-1])
-    finally:
-        subprocess.run(['git', '-C', command_path.ROOT, 'worktree', 'remove', '--force', old],
-                       capture_output=True)
+    """Return RESULTS.md lines: cost and accuracy of each variant."""
     unit, after = rows()
-    lines = [f'The unit, plain pure-Python RK4 at 1 ms: {before_unit * 1e3:.2f} ms per simulated '
-             f's in the run of {command_path.BEFORE}, {unit * 1e3:.2f} in this one.', '',
-             f'| body given by | torque callable | attitude error (rad) | cost / unit, '
-             f'{command_path.BEFORE} | cost / unit, now | ms per simulated s, now |',
-             '|---|---|---|---|---|---|']
+    lines = [f'The unit, plain pure-Python RK4 at 1 ms: {unit * 1e3:.2f} ms per simulated s.', '',
+             '| body given by | torque callable | attitude error (rad) | cost / unit | '
+             'ms per simulated s |', '|---|---|---|---|---|']
     for body, fn, error, cost in after:
-        old_cost = next((c for b, f, _e, c in before if (b, f) == (body, fn)), None)
-        lines.append(f'| {body} | {fn} | {fmt(error)} | '
-                     f'{"n/a" if old_cost is None else f"{old_cost / before_unit:.2f}"} | '
-                     f'{cost / unit:.2f} | {cost * 1e3:.2f} |')
+        lines.append(f'| {body} | {fn} | {fmt(error)} | {cost / unit:.2f} | {cost * 1e3:.2f} |')
     return lines
 
 
 if __name__ == '__main__':
-    if sys.argv[1:] == ['--rows']:
-        print(json.dumps(rows()))
-    else:
-        print('\n'.join(measure()))
+    print('\n'.join(measure()))
