@@ -94,7 +94,7 @@ def settle_heap():
 
     A full collection traverses every object the collector tracks, with every thread of
     the process stopped: in a 48-body fleet (120 000 objects after start-up: modules,
-    nodes, message types) one took 70 ms, and every body's steps in it were late. The
+    nodes, message types) one took 70-90 ms, and every body's steps in it were late. The
     objects made at start-up live as long as the process, so they are frozen after one
     collection; later collections traverse only what was made since.
     """

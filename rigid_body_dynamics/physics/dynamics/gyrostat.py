@@ -164,7 +164,7 @@ class GyrostatIntegrator:
     ``moments`` (principal, kg m^2, the wheels included), ``wheels`` (:class:`Wheels`,
     axes in the principal frame), ``dt`` (s), ``q0`` (x, y, z, w; principal frame ->
     world), ``omega0`` (rad/s, principal frame), ``speeds0`` (rad/s relative to the
-    body), ``method`` 'exact' (order 8) or 'rk4'. The motor command is held
+    body), ``method`` 'exact' (order 6 or 8) or 'rk4'. The motor command is held
     (:meth:`command_motors`, N m) and limited at the start of every step. The same
     protocol as :mod:`.integrators` (``step``, ``free_steps``, ``q``, ``omega``,
     ``time``, ``work``, ``impulse``, ``kinetic_energy``, ``angular_momentum_world``),
