@@ -41,7 +41,7 @@ if os.environ.get('LATE_STEPS_NO_FREEZE') == '1':   # the fleet as before: nothi
     from rigid_body_dynamics.ros import runner
     runner.settle_heap = lambda: None
 clock = time.monotonic_ns
-events = {'gc': [], 'late': [], 'long': [], 'executor': []}
+events = {'gc': [], 'late': [], 'long': []}
 recording = threading.Event()
 started = {}
 
@@ -107,20 +107,6 @@ def timed_member(self, pace, publish, *args, **kwargs):
     member_init(self, pace, timed_publish, *args, **kwargs)
 
 loop.Member.__init__ = timed_member
-
-from rclpy.executors import SingleThreadedExecutor
-spin_once = SingleThreadedExecutor.spin_once
-
-def recorded_spin_once(self, *args, **kwargs):
-    start = clock()
-    try:
-        return spin_once(self, *args, **kwargs)
-    finally:
-        end = clock()
-        if recording.is_set() and end - start > 1_000_000:
-            events['executor'].append((start, end))
-
-SingleThreadedExecutor.spin_once = recorded_spin_once
 
 def record():
     time.sleep(warmup)
