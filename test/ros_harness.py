@@ -166,6 +166,7 @@ class Probe(RosClient):
     def __init__(self, name='probe'):
         super().__init__(name)
         self.messages = {}
+        self._clients = {}          # (service type, name) -> client: see call()
 
     def subscribe(self, msg_type, topic, qos=DEEP):
         """Collect every message on ``topic`` into ``self.messages[topic]``; returns that list."""
@@ -226,12 +227,19 @@ class Probe(RosClient):
             return {}
 
     def call(self, srv_type, name, request, timeout=20.0):
-        """Call a service and return its response."""
-        client = self.node.create_client(srv_type, name)
+        """
+        Call a service and return its response.
+
+        One client per service and type, kept: a new client is a new response reader, and
+        a server that answers a reader it has not discovered yet drops the response
+        (rmw_fastrtps waits 100 ms for the match), which a busy machine can outlast.
+        """
+        client = self._clients.get((srv_type, name))
+        if client is None:
+            client = self._clients[srv_type, name] = self.node.create_client(srv_type, name)
         self.spin_until(client.service_is_ready, timeout, f'service {name}')
         future = client.call_async(request)
         self.spin_until(future.done, timeout, f'the response of {name}')
-        self.node.destroy_client(client)
         return future.result()
 
     def newest_status(self, name):

@@ -30,6 +30,19 @@ OMEGA0 = [0.3, 1.5, -0.4]
 OK, FAILED = Result.RESULT_OK, Result.RESULT_OPERATION_FAILED
 
 
+def started(launch, probe, *args, ns=''):
+    """
+    Launch the simulator with ``args`` and return once its first odom arrived.
+
+    Then it has discovered this probe (its odom reached the probe's reader): a service
+    that answers a client it has not discovered yet drops the response (rmw_fastrtps
+    waits 100 ms for the match), which beside a CPU hog lost a first call in CI runs.
+    """
+    launch(SIM, *args, name='sim')
+    probe.subscribe(Odometry, f'{ns}/odom')
+    probe.wait_for(f'{ns}/odom', 1, timeout=30.0)
+
+
 def call(probe, name, request, ns=''):
     """Call the simulator's service ``name`` (a simulation_interfaces type) and return it."""
     srv_type = {'get_simulator_features': sim_srv.GetSimulatorFeatures,
@@ -98,8 +111,8 @@ def test_the_simulation_state_machine_and_exact_stepping(launch, probe):
     A run stopped at launch and stepped 1234 steps by the service, then 500 by the action,
     is at t = 1.734 s in the same state as simulate() run free to 1.734 s, bit for bit.
     """
-    launch(SIM, '-p', 'preset:=tennis_racket', '-p', 'publish_clock:=true',
-           '-p', f'initial_angular_velocity:={OMEGA0}', name='sim')
+    started(launch, probe, '-p', 'preset:=tennis_racket', '-p', 'publish_clock:=true',
+            '-p', f'initial_angular_velocity:={OMEGA0}')
     moments = presets.get('tennis_racket').moments
     features = call(probe, 'get_simulator_features', None).features.features
     f = SimulatorFeatures
@@ -153,8 +166,8 @@ def test_the_simulation_state_machine_and_exact_stepping(launch, probe):
 
 def test_resets_by_scope_and_setting_the_entity_state(launch, probe):
     """Reset by the TIME, STATE and ALL scopes; GetEntities; SetEntityState and its refusals."""
-    launch(SIM, '-p', 'publish_clock:=true', '-p', f'initial_angular_velocity:={OMEGA0}',
-           name='sim')
+    started(launch, probe, '-p', 'publish_clock:=true', '-p',
+            f'initial_angular_velocity:={OMEGA0}')
     s = SimulationState
     assert set_state(probe, s.STATE_STOPPED) == OK
     call(probe, 'step_simulation', sim_srv.StepSimulation.Request(steps=700))
@@ -214,8 +227,8 @@ def test_resets_by_scope_and_setting_the_entity_state(launch, probe):
 def test_in_orbit_the_entity_state_carries_the_orbit(launch, probe):
     """In orbit: pose.position and twist.linear are Kepler's, acceleration two-body gravity."""
     elements = [7.0e6, 0.01, 1.7, 0.8, 0.3, 0.2]
-    launch(SIM, '-p', 'publish_clock:=true', '-p', f'orbit_elements:={elements}',
-           '-p', 'gravity_gradient:=true', name='sim')
+    started(launch, probe, '-p', 'publish_clock:=true', '-p', f'orbit_elements:={elements}',
+            '-p', 'gravity_gradient:=true')
     assert set_state(probe, SimulationState.STATE_STOPPED) == OK
     call(probe, 'step_simulation', sim_srv.StepSimulation.Request(steps=2500))
     t, _q, _w, response = entity(probe)
