@@ -63,12 +63,26 @@ def probe():
     p.close()
 
 
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """Keep each phase's report on the test item (the launch fixture reads the call's)."""
+    outcome = yield
+    report = outcome.get_result()
+    setattr(item, f'report_{report.when}', report)
+
+
+#: Lines of each node's output shown when a test that launched it failed.
+LOG_TAIL = 60
+
+
 @pytest.fixture
-def launch(tmp_path):
+def launch(tmp_path, request):
     """
     Start node processes: call the fixture with a module, ros args, a name (and env additions).
 
-    Every process still running at the end of the test is stopped with SIGINT.
+    Every process still running at the end of the test is stopped with SIGINT. When the
+    test failed, the end of each node's output is printed (the report's teardown output),
+    since the temporary folder holding it is not kept.
     """
     from ros_harness import NodeProcess
     started = []
@@ -81,6 +95,11 @@ def launch(tmp_path):
     for proc in started:
         if proc.proc.poll() is None:
             proc.stop()
+    report = getattr(request.node, 'report_call', None)
+    if report is not None and report.failed:
+        for proc in started:
+            lines = proc.output().splitlines()[-LOG_TAIL:]
+            print(f'--- {proc.log_path} (last {len(lines)} lines) ---', *lines, sep='\n')
 
 
 @pytest.fixture(scope='session')
