@@ -172,13 +172,12 @@ STEP_TORQUE = (0.01, -0.02, 0.005)
 
 def _us_per_step(stepper, torque, steps=2000, repeats=5):
     """Return the least wall time (us) of one ``stepper.step(torque)`` over ``repeats`` runs."""
-    best = math.inf
-    for _ in range(repeats):
+    def run():
         start = time.perf_counter()
         for _ in range(steps):
             stepper.step(torque)
-        best = min(best, (time.perf_counter() - start) / steps)
-    return best * 1e6
+        return ((time.perf_counter() - start) / steps,)
+    return best_of(run, repeats)[0] * 1e6
 
 
 def step_cost():
