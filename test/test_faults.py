@@ -75,3 +75,24 @@ def test_analyzer_crash_and_simulator_restart(launch, probe, monkeypatch):
     for proc in (analyzer, sim):
         code, _ = proc.stop()
         assert code == 0, proc.output()
+
+
+def test_a_node_that_does_not_stop_says_where_it_is_before_it_is_killed(
+        launch, probe, monkeypatch):
+    """
+    dump_and_kill: SIGUSR1 makes a running node print each thread's stack, then SIGKILL.
+
+    The fleet's parent does this to a worker that does not exit after the stop, and the test
+    harness to a node; the stacks name the integration thread and the executor.
+    """
+    from nav_msgs.msg import Odometry
+    from rigid_body_dynamics.ros.client import dump_and_kill
+    monkeypatch.setenv('FASTDDS_BUILTIN_TRANSPORTS', 'UDPv4')     # SIGKILL: no shm left
+    sim = launch('rigid_body_dynamics.nodes.simulator', name='sim')
+    probe.subscribe(Odometry, '/odom')
+    probe.wait_for('/odom')                 # running: its threads exist
+    assert dump_and_kill(sim.proc) == -signal.SIGKILL
+    output = sim.output()
+    assert output.count('Thread 0x') + output.count('Current thread 0x') == 3, output
+    for where in ('in integration_loop', 'in spin\n', 'in _spin'):
+        assert where in output, output

@@ -30,6 +30,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 import rclpy
 from rclpy.signals import SignalHandlerOptions
 
+from ..ros.client import dump_and_kill
 from ..ros.conversions import status
 from ..ros.parameters import ConfigurationError
 from ..ros.runner import stop_on_signals
@@ -266,10 +267,10 @@ class Supervisor:
             try:
                 code = worker.proc.wait(max(0.0, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
-                worker.proc.kill()
-                code = worker.proc.wait()
+                code = dump_and_kill(worker.proc)
                 self.logger.error(f'worker {worker.index + 1} (pid {worker.pid}) did not exit '
-                                  f'within {EXIT_WAIT:g} s of the stop: killed')
+                                  f'within {EXIT_WAIT:g} s of the stop: killed (the stacks of its '
+                                  'threads are printed above)')
             if worker.death is None and code != 0:
                 self.logger.error(f'worker {worker.index + 1} (pid {worker.pid}) exited with '
                                   f'{describe(code)}')

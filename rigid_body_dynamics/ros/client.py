@@ -82,12 +82,34 @@ def start_node(module, ros_args=(), **popen):
 
 
 def interrupt(proc, timeout=10.0):
-    """SIGINT a process (as Ctrl-C does) and wait; kill after ``timeout`` s; its exit code."""
+    """
+    SIGINT a process (as Ctrl-C does) and wait; its exit code.
+
+    One still running after ``timeout`` s is killed with :func:`dump_and_kill`, so its
+    output says where each of its threads was.
+    """
     if proc.poll() is None:
         proc.send_signal(signal.SIGINT)
         try:
             proc.wait(timeout)
         except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(5.0)
+            dump_and_kill(proc)
     return proc.returncode
+
+
+def dump_and_kill(proc, grace=1.0):
+    """
+    Have a stuck package process print its threads' stacks (SIGUSR1), then SIGKILL it.
+
+    Every node registers SIGUSR1 with faulthandler (``runner.run``), which writes the
+    Python stack of each thread to stderr at once, whatever the interpreter is doing.
+    ``grace``: seconds given to the dump before the kill. Returns the exit code.
+    """
+    try:
+        proc.send_signal(signal.SIGUSR1)
+        proc.wait(grace)
+    except subprocess.TimeoutExpired:
+        pass
+    if proc.poll() is None:
+        proc.kill()
+    return proc.wait(5.0)

@@ -9,6 +9,7 @@ checks it, then wakes the executor thread and waits for it, so shutdown always
 happens between callbacks.
 """
 
+import faulthandler
 import gc
 import signal
 import threading
@@ -74,8 +75,11 @@ def stop_on_signals(early=None):
     """
     Make SIGINT / SIGTERM set the returned Event (set already if ``early`` holds a signal).
 
-    Returns (stop, restore): ``restore()`` puts the previous handlers back.
+    Returns (stop, restore): ``restore()`` puts the previous handlers back. SIGUSR1 prints
+    the Python stack of every thread to stderr (faulthandler), so a process that does not
+    stop can say where it is (``ros.client.dump_and_kill``).
     """
+    faulthandler.register(signal.SIGUSR1, all_threads=True)
     stop = threading.Event()
     previous = {sig: signal.signal(sig, lambda *_: stop.set())
                 for sig in (signal.SIGINT, signal.SIGTERM)}
