@@ -254,6 +254,82 @@ def test_the_controller_drops_hostile_odometry_and_exits_zero(launch, probe):
     assert code == 0 and 'Traceback' not in ctl.output()
 
 
+def _answers_by_stamp(answers):
+    return [(time_ns(a.header.stamp), a) for a in answers]
+
+
+def test_the_controller_answers_a_state_sent_again_with_the_same_command(launch, probe):
+    """
+    A state it answered, seen again, is answered again the same; one not due is not.
+
+    Lockstep sends its first state again every second until the tick is answered: the
+    answer to the first copy is lost when the simulator's subscription did not know the
+    controller's publisher yet, and the run must not then wait for ever.
+    """
+    from geometry_msgs.msg import InertiaStamped
+    from ros_harness import LATCHED, odom_msg
+    launch('rigid_body_dynamics.nodes.controller', name='ctl')        # 100 Hz of stamps
+    answers = probe.subscribe(WrenchStamped, 'torque_cmd')
+    inertia = probe.node.create_publisher(InertiaStamped, 'inertia', LATCHED)
+    msg = InertiaStamped()
+    msg.inertia.ixx, msg.inertia.iyy, msg.inertia.izz = 1.0, 2.0, 3.0
+    inertia.publish(msg)
+    odom = probe.publisher(Odometry, 'odom')
+    q = (0.1, 0.0, 0.0, math.sqrt(0.99))
+    probe.handshake(odom, odom_msg(0.0, q, (0.1, 0.0, 0.0)), lambda: bool(answers))
+    # (each alone: the controller answers the newest of the states pending together)
+    for k in (1, 2):                          # due, answered; the same again, answered again
+        odom.publish(odom_msg(0.01, q, (0.2, 0.0, 0.0)))
+        probe.spin_until(lambda: sum(t == 10_000_000 for t, _ in _answers_by_stamp(
+            answers)) == k, 10.0, f'answer {k} to the state at 0.01 s')
+    odom.publish(odom_msg(0.01, q, (0.3, 0.0, 0.0)))          # other values, not due
+    odom.publish(odom_msg(0.015, q, (0.2, 0.0, 0.0)))         # not due
+    odom.publish(odom_msg(0.02, q, (0.2, 0.0, 0.0)))          # due
+    probe.spin_until(lambda: any(t == 20_000_000 for t, _ in _answers_by_stamp(answers)),
+                     10.0, 'the answer to the state at 0.02 s')
+    got = [(t, a.wrench.torque) for t, a in _answers_by_stamp(answers) if t > 0]
+    assert [t for t, _ in got] == [10_000_000, 10_000_000, 20_000_000], got
+    assert got[0][1] == got[1][1] and got[0][1].x < 0.0
+
+
+def test_bdot_answers_a_reading_sent_again_with_the_same_dipole(launch, probe):
+    """
+    A magnetometer reading it answered, seen again, gets the same dipole, not a new dB/dt.
+
+    The law keeps the last reading for dB/dt: going through it a second time with the same
+    reading would give zero (no time passed), so the answer sent again is the one kept.
+    """
+    from geometry_msgs.msg import Vector3Stamped
+    from rigid_body_dynamics.physics.control import BDot
+    from rigid_body_dynamics.ros.conversions import time_msg, vector_msg
+    from sensor_msgs.msg import MagneticField
+    launch('rigid_body_dynamics.nodes.controller', '-p', 'mode:=bdot', '-p',
+           'actuator:=magnetorquers', '-p', 'bdot_gain:=100000.0',
+           '-p', 'magnetorquer_max_dipole:=[0.2, 0.2, 0.2]', name='ctl')
+    answers = probe.subscribe(Vector3Stamped, 'magnetorquer_cmd')
+
+    def reading(t, b):
+        msg = MagneticField()
+        msg.header.stamp = time_msg(round(t * 1e9))
+        msg.magnetic_field = vector_msg(b)
+        return msg
+    b0, b1 = (2e-5, -1e-5, 3e-5), (2.1e-5, -1.05e-5, 2.9e-5)
+    field = probe.publisher(MagneticField, 'magnetic_field')
+    probe.handshake(field, reading(0.0, b0), lambda: bool(answers))
+    field.publish(reading(1.0, b1))
+    field.publish(reading(1.0, b1))
+    field.publish(reading(2.0, b1))
+    probe.spin_until(lambda: any(t == 2 * 10 ** 9 for t, _ in _answers_by_stamp(answers)),
+                     10.0, 'the answer to the reading at 2 s')
+    law = BDot(1e5, (0.2, 0.2, 0.2))
+    law.dipole(0.0, b0)
+    expected = law.dipole(1.0, b1)
+    got = [(t, (a.vector.x, a.vector.y, a.vector.z)) for t, a in _answers_by_stamp(answers)
+           if t > 0]
+    assert got == [(10 ** 9, expected), (10 ** 9, expected), (2 * 10 ** 9, law.dipole(2.0, b1))]
+    assert max(map(abs, expected)) > 0.05
+
+
 @pytest.mark.parametrize('args, reason', [
     (('-p', 'target_orientation:=[0.0, 0.0, 0.0, 0.0]'),
      'target_orientation must not be the zero quaternion'),

@@ -7,6 +7,9 @@ is at least one control period after the last answered one gets a
 what a real controller should do anyway: the command says which state it
 answers). With the simulator in lockstep the closed loop is then
 deterministic; in real time it runs at ``control_rate`` of the state stream.
+A state (or magnetometer reading) seen again, stamp and values, gets the same
+answer again: lockstep sends its first tick again until it is answered, and an
+answer lost to discovery must not stall the run.
 
 The law lives in the physics layer (:mod:`rigid_body_dynamics.physics.control`,
 ROS-free, so ``simulate(...)`` closes the same loop offline): ``slew`` is a
@@ -143,6 +146,9 @@ class AttitudeController(Node):
         self._next_due_ns = None
         self._last_ns = None
         self.answered = 0
+        self.repeated = 0                          # answers sent again (see _repeat)
+        # (what it answered: stamp and values, [(publisher, message), ...]) of the last answer
+        self._answer = None
         self.dropped = 0                           # inputs with a non-finite number
         self._warnings = ThrottledWarnings(self.get_logger())
         self._bdot = self._values['mode'] == 'bdot'
@@ -276,7 +282,10 @@ class AttitudeController(Node):
         if self._hostile((b.x, b.y, b.z), 'magnetic_field'):
             return
         stamp = conv.time_ns(msg.header.stamp)
+        key = (stamp, b.x, b.y, b.z)
         with self._lock:
+            if self._repeat(key):
+                return
             law = self._law
             if self._last_ns is not None and stamp < self._last_ns:
                 self._next_due_ns = None           # the simulator was reset: start over
@@ -290,7 +299,32 @@ class AttitudeController(Node):
         cmd.header.stamp = msg.header.stamp
         cmd.header.frame_id = msg.header.frame_id
         cmd.vector.x, cmd.vector.y, cmd.vector.z = dipole
-        self._pub_dipole.publish(cmd)
+        self._send(key, [(self._pub_dipole, cmd)])
+
+    def _repeat(self, key):
+        """
+        Publish the last answer again if ``key`` (stamp, values) is what it answered (locked).
+
+        A simulator in lockstep sends its first state and readings again every second
+        until that tick is answered: an answer published before the simulator's
+        subscription knew this publisher is lost (a volatile reader gets nothing sent
+        before it matched), and a state that was answered once is not due again. The
+        same input gets the same answer, without going through the law a second time
+        (B-dot's dB/dt keeps the last reading). Returns whether it did.
+        """
+        if self._answer is None or self._answer[0] != key:
+            return False
+        for pub, msg in self._answer[1]:
+            pub.publish(msg)
+        self.repeated += 1
+        return True
+
+    def _send(self, key, messages):
+        """Publish the answer to ``key``: [(publisher, message), ...] in order; keep it."""
+        with self._lock:
+            self._answer = (key, messages)
+        for pub, msg in messages:
+            pub.publish(msg)
         self.answered += 1
 
     def _speeds_at(self, stamp_ns):
@@ -336,7 +370,10 @@ class AttitudeController(Node):
         if self._hostile((o.x, o.y, o.z, o.w, w.x, w.y, w.z), 'odom', (o.x, o.y, o.z, o.w)):
             return
         stamp = conv.time_ns(odom.header.stamp)
+        key = (stamp, o.x, o.y, o.z, o.w, w.x, w.y, w.z)
         with self._lock:
+            if self._repeat(key):
+                return
             law = self._law
             rate = self._values['control_rate']
             if self._last_ns is not None and stamp < self._last_ns:
@@ -353,10 +390,10 @@ class AttitudeController(Node):
         cmd.header.stamp = odom.header.stamp
         cmd.header.frame_id = odom.child_frame_id
         cmd.wrench.torque.x, cmd.wrench.torque.y, cmd.wrench.torque.z = tau
-        self._pub.publish(cmd)
+        messages = [(self._pub, cmd)]
         if motors is not None:
-            self._pub_wheels.publish(Float64MultiArray(data=list(motors)))
-        self.answered += 1
+            messages.append((self._pub_wheels, Float64MultiArray(data=list(motors))))
+        self._send(key, messages)
 
     def destroy_node(self):
         """Destroy the intake's helper node too."""
