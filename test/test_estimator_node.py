@@ -83,3 +83,57 @@ def test_the_example_mekf_is_consistent_and_a_detuned_one_overconfident(launch, 
         np.reshape(m.pose.covariance, (6, 6))[3:, 3:])) for m in estimates}
     assert sigma[445] > 3.0 * sigma[400], (sigma[400], sigma[445])
     assert sigma[480] < 1.5 * sigma[400]                 # and recovers once it sees again
+
+
+def test_a_gyro_at_another_rate_after_a_reset_is_no_gap(launch, probe):
+    """
+    Gyro stamps that go back restart the estimate, and the usual interval with it.
+
+    10 ms readings, then a reset (the stamps go back) to 100 ms readings: a new rate, not
+    readings missing, so no gap is counted; a 400 ms hole after that is one. A reading left
+    pending from the run before a reset is dropped, not used in the next run.
+    """
+    import time
+    from rigid_body_dynamics.ros.conversions import time_msg
+    from ros_harness import DEEP
+    from sensor_msgs.msg import Imu
+    launch('rigid_body_dynamics.nodes.estimator', '-p',        # (a burst: none dropped)
+           'qos_overrides./imu.subscription.depth:=1000', name='estimator')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    imu = probe.publisher(Imu, 'imu', qos=DEEP)
+
+    def reading(ns):
+        msg = Imu()
+        msg.header.stamp = time_msg(ns)
+        return msg
+
+    def status():
+        found = probe.newest_status('attitude_estimator: filter')
+        return found[2] if found else {'gyro messages used': '0', 'restarts': '0'}
+
+    def used():
+        return int(status()['gyro messages used'])
+    # 10 ms readings from 100 s on until one is used (the first ones may be lost to
+    # discovery; a reading is used when the next one has come)
+    stamp, deadline = 100 * 10 ** 9, time.monotonic() + 20.0
+    while not used():
+        assert time.monotonic() < deadline, 'no gyro reading reached the estimator'
+        stamp += 10 ** 7
+        imu.publish(reading(stamp))
+        until = time.monotonic() + 0.5
+        probe.spin_until(lambda: used() or time.monotonic() > until, 1.0, 'half a second')
+    imu.publish(reading(50 * 10 ** 9))      # a reset: the status then counts every one used
+    probe.spin_until(lambda: status()['restarts'] == '1', 20.0, 'the first reset')
+    used_before = int(status()['gyro messages used'])
+    # then 10 ms readings from 0 (a reset), 100 ms ones from 0 (another) with a hole, and a
+    # last reset: seen in the status, it says every reading before it was taken (in order)
+    stamps = [k * 10 ** 7 for k in range(1, 11)] + [k * 10 ** 8 for k in range(6)] + [
+        9 * 10 ** 8, 10 ** 9, 0]
+    for ns in stamps:
+        imu.publish(reading(ns))
+    probe.spin_until(lambda: status()['restarts'] == '4', 20.0, 'the fourth reset')
+    values = status()
+    # used: 9 of the 10 ms readings and 7 of the 100 ms ones; the newest of each run waits for
+    # a later stamp, and the reset after it drops it (it belongs to the run before)
+    assert int(values['gyro messages used']) == used_before + 16, (used_before, values)
+    assert values['gyro gaps (readings missing)'] == '1'         # 0.5 -> 0.9 s only

@@ -117,7 +117,6 @@ class AttitudeEstimator(Node):
         self._sequence = 0
         self.counts = dict.fromkeys(('gyro', 'star_tracker', 'sun_sensor', 'magnetometer',
                                      'late', 'gyro gaps', 'restarts'), 0)
-        self._gyro_interval = None    # the shortest interval between gyro stamps seen (ns)
         self._restart()
         self._pub = self.create_publisher(PoseWithCovarianceStamped, 'attitude_estimate',
                                           STATE_QOS)
@@ -148,6 +147,9 @@ class AttitudeEstimator(Node):
         self._time = None          # the filter's stamp (ns)
         self._gyro = None          # (stamp ns, measured rate) of the last gyro sample
         self._newest = None
+        # the shortest interval between gyro stamps seen (ns): a reset simulator may sample
+        # at another rate
+        self._gyro_interval = None
 
     # ---------------------------------------------------------------- intake
     def _queue(self, msg, kind):
@@ -160,8 +162,11 @@ class AttitudeEstimator(Node):
         if self._newest is not None and stamp < self._newest:
             self.counts['restarts'] += 1
             self.get_logger().info('the gyro stamps went back (a reset): the estimate restarts')
+            # what is still pending at or after the last gyro stamp came from the run before
+            # the reset; what came since, stamped before this sample, is too early to use
+            newest = self._newest
             self._restart()
-            self._pending = [p for p in self._pending if p[0] >= stamp]
+            self._pending = [p for p in self._pending if stamp <= p[0] < newest]
             heapq.heapify(self._pending)
         self._newest = stamp
         w = msg.angular_velocity
