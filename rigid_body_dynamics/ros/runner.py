@@ -78,7 +78,8 @@ def stop_on_signals(early=None):
 
     Returns (stop, restore): ``restore()`` puts the previous handlers back. SIGUSR1 prints
     the Python stack of every thread to stderr (faulthandler), so a process that does not
-    stop can say where it is (``ros.client.dump_and_kill``).
+    stop can say where it is (``ros.client.dump_and_kill``); that stays after ``restore()``,
+    for a process that hangs on its way out.
     """
     faulthandler.register(signal.SIGUSR1, all_threads=True)
     stop = threading.Event()
