@@ -110,10 +110,11 @@ MEANINGS = {
     'body_rate': "axisymmetric: omega turning about the symmetry axis in the body (Shapiro's "
                  'Omega)',
     'lab_rate': 'axisymmetric: the symmetry axis turning about L, |L|/I_perp',
-    'omega_period': 'asymmetric: the period of omega(t)',
+    'omega_period': 'asymmetric: the period of omega(t), fitted to the sign changes of its '
+                    'middle-axis component (one across a gap in the samples left out)',
     'mean_precession': "asymmetric: the circled axis's mean precession about L",
     'growth_rate': 'unstable spin: growth rate of a small departure',
-    'flip_interval': 'unstable spin: time between flips',
+    'flip_interval': 'unstable spin: time between flips (fitted as the omega period)',
     'wobble_frequency': 'stable spin: 2 pi / period of omega',
     'pitch': 'gravity-gradient pitch libration about LVLH, n sqrt(3 (Ix - Iz) / Iy) by theory',
     'roll_yaw_slow': 'the slower root of the roll-yaw libration (Wie, section 6.3)',
