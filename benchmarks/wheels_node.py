@@ -4,9 +4,12 @@ attitude_simulator with reaction wheels: CPU at the defaults, and the highest ra
 The default body (1 kHz steps, 100 Hz publishing, real time) without wheels, with the four
 pyramid wheels of ``doc/examples/wheels.yaml`` held at zero motor torque, and with the same
 wheels driven (a wheel_cmd publisher at 100 Hz in the same process as the probe); CPU is the
-simulator's share of one core over 8 s after 3 s of warm-up, each case twice, alternating.
-With wheels every step is a Runge-Kutta step of the gyrostat (order 6 or 8; no exact
-torque-free flow to skip steps on), so the figure is the cost of the gyrostat in a node.
+simulator's share of one core over 8 s after 3 s of warm-up, each case twice, alternating,
+on the idle machine and beside one CPU-bound process (``while 1: pass``, started and ended by
+the benchmark). On this virtual machine the same code measured three times more a few hours
+apart (commit 4d8e198, 2026-12-03, idle: no wheels 0.036 and 0.061, four wheels at 0 0.104
+and 0.115, driven 0.127 and 0.150), so a figure here holds for its run. With wheels every step is a Runge-Kutta step of the gyrostat (order 6 or 8; no
+exact torque-free flow to skip steps on), so the figure is the cost of the gyrostat in a node.
 Before the gyrostat's step was unrolled (commit ab2afd7, on AMD EPYC 2 cores on 2026-12-03):
 no wheels 0.053, four wheels at 0 0.259, driven 0.308 of a core (medians of two).
 ``./dev bench --only wheels-node``.
@@ -16,12 +19,14 @@ import os
 import statistics
 
 from diagnostic_msgs.msg import DiagnosticArray
-from nodes import measure_cpu, Probe, sim
+from nodes import measure_cpu, Probe, script, sim
 from std_msgs.msg import Float64MultiArray
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WHEELS = os.path.join(HERE, '..', 'doc', 'examples', 'wheels.yaml')
 ROUNDS = 2
+#: The two conditions: the machine idle, and one CPU-bound process beside the node.
+CONDITIONS = (('idle', ()), ('beside a CPU-bound process', (script('while 1: pass'),)))
 
 
 def measure():
@@ -35,22 +40,24 @@ def measure():
     cases = {'no wheels': (sim(), False),
              'four wheels, motors at 0': (sim() + ['--params-file', WHEELS], False),
              'four wheels, driven at 100 Hz': (sim() + ['--params-file', WHEELS], True)}
-    found = {name: [] for name in cases}
+    found = {(name, condition): [] for name in cases for condition, _ in CONDITIONS}
     try:
         for _ in range(ROUNDS):
-            for name, (cmd, drive) in cases.items():
-                driving[:] = [True] if drive else []
-                cpu, diag = measure_cpu(cmd, probe)
-                rtf = float(diag[1]['achieved real-time factor']) if diag else float('nan')
-                found[name].append((cpu, rtf))
-                print(f'{name}: {cpu:.3f} of a core, achieved {rtf:.3f}', flush=True)
+            for condition, companions in CONDITIONS:
+                for name, (cmd, drive) in cases.items():
+                    driving[:] = [True] if drive else []
+                    cpu, diag = measure_cpu(cmd, probe, companions=companions)
+                    rtf = float(diag[1]['achieved real-time factor']) if diag else float('nan')
+                    found[name, condition].append((cpu, rtf))
+                    print(f'{name}, {condition}: {cpu:.3f} of a core, achieved {rtf:.3f}',
+                          flush=True)
     finally:
         probe.close()
-    lines = ['| simulator | CPU (share of one core, each run) | achieved real-time factor |',
-             '|---|---|---|']
-    for name, runs in found.items():
-        lines.append(f'| {name} | {", ".join(f"{c:.3f}" for c, _r in runs)} (median '
-                     f'{statistics.median(c for c, _r in runs):.3f}) | '
+    lines = ['| simulator | machine | CPU (share of one core, each run) | achieved real-time '
+             'factor |', '|---|---|---|---|']
+    for (name, condition), runs in found.items():
+        lines.append(f'| {name} | {condition} | {", ".join(f"{c:.3f}" for c, _r in runs)} '
+                     f'(median {statistics.median(c for c, _r in runs):.3f}) | '
                      f'{", ".join(f"{r:.3f}" for _c, r in runs)} |')
     return lines
 
