@@ -96,3 +96,18 @@ def test_a_node_that_does_not_stop_says_where_it_is_before_it_is_killed(
     assert output.count('Thread 0x') + output.count('Current thread 0x') == 3, output
     for where in ('in integration_loop', 'in spin\n', 'in _spin'):
         assert where in output, output
+
+
+def test_a_second_signal_during_the_first_ones_stop_does_not_deadlock():
+    """
+    The handler takes no lock: a signal arriving inside a stop in progress returns at once.
+
+    A fleet worker got SIGINT from its parent and SIGTERM from its closed lifeline at once;
+    the second handler ran inside the first's Event.set(), waited for the lock that set()
+    held, and the worker never exited. Here the lock is held as set() holds it.
+    """
+    from rigid_body_dynamics.ros.runner import Stop
+    stop = Stop()
+    with stop._event._cond:                  # inside Event.set(), as the second signal came
+        stop.on_signal(signal.SIGTERM, None)
+    assert stop.is_set() and stop.wait(0.0)

@@ -72,9 +72,47 @@ def _spin(nodes, stop):
         raise failure[0]
 
 
+class Stop:
+    """
+    The stop flag of a process: set by a signal handler, by another thread, or both at once.
+
+    A signal handler runs in the main thread between two bytecodes, possibly inside a
+    ``threading.Event.set()`` that the main thread is already running (its condition's lock
+    held): a second signal that called ``set()`` there waited for that lock for ever (a fleet
+    worker stopped by SIGINT and, at once, by its closed lifeline's SIGTERM did not exit).
+    So the handler only stores an attribute; :meth:`is_set` and :meth:`wait` see it.
+    """
+
+    def __init__(self):
+        self._event = threading.Event()
+        self.signalled = False
+
+    def on_signal(self, *_):
+        """Signal handler: no lock, no call into threading."""
+        self.signalled = True
+
+    def set(self):  # noqa: A003 (the threading.Event interface)
+        """Stop (from a thread, not a signal handler)."""
+        self._event.set()
+
+    def is_set(self):
+        """Return whether the stop came (a signal or :meth:`set`)."""
+        return self.signalled or self._event.is_set()
+
+    def wait(self, timeout):
+        """Wait up to ``timeout`` s for the stop (a signal is seen within SLICE s); is_set()."""
+        end = time.monotonic() + timeout
+        while not self.is_set():
+            left = end - time.monotonic()
+            if left <= 0.0:
+                return False
+            self._event.wait(min(left, SLICE))
+        return True
+
+
 def stop_on_signals(early=None):
     """
-    Make SIGINT / SIGTERM set the returned Event (set already if ``early`` holds a signal).
+    Make SIGINT / SIGTERM set the returned :class:`Stop` (set already if ``early`` holds one).
 
     Returns (stop, restore): ``restore()`` puts the previous handlers back. SIGUSR1 prints
     the Python stack of every thread to stderr (faulthandler), so a process that does not
@@ -82,8 +120,8 @@ def stop_on_signals(early=None):
     for a process that hangs on its way out.
     """
     faulthandler.register(signal.SIGUSR1, all_threads=True)
-    stop = threading.Event()
-    previous = {sig: signal.signal(sig, lambda *_: stop.set())
+    stop = Stop()
+    previous = {sig: signal.signal(sig, stop.on_signal)
                 for sig in (signal.SIGINT, signal.SIGTERM)}
     if early:
         stop.set()
