@@ -200,6 +200,15 @@ def test_bad_closed_loop_parameters_are_refused_with_the_reason(launch, args, re
     assert reason in proc.output()
 
 
+def _latch_inertia(probe, moments=(1.0, 2.0, 3.0)):
+    """Publish the body's inertia latched, as the simulator does (the controller waits for it)."""
+    from geometry_msgs.msg import InertiaStamped
+    from ros_harness import LATCHED
+    msg = InertiaStamped()
+    msg.inertia.ixx, msg.inertia.iyy, msg.inertia.izz = moments
+    probe.node.create_publisher(InertiaStamped, 'inertia', LATCHED).publish(msg)
+
+
 def test_the_controller_takes_best_effort_odometry_when_told(launch, probe):
     """
     Answer a best-effort odom source once told so by qos_overrides.
@@ -207,17 +216,13 @@ def test_the_controller_takes_best_effort_odometry_when_told(launch, probe):
     It does not reach the controller's reliable subscription by default; with
     qos_overrides./odom.subscription.reliability best_effort it does, and is answered.
     """
-    from geometry_msgs.msg import InertiaStamped, WrenchStamped
     from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from ros_harness import LATCHED, odom_msg
+    from ros_harness import odom_msg
     best_effort = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
     launch('rigid_body_dynamics.nodes.controller', '-p', 'control_rate:=0.0',
            '-p', 'qos_overrides./odom.subscription.reliability:=best_effort', name='ctl')
     answers = probe.subscribe(WrenchStamped, 'torque_cmd')
-    inertia = probe.node.create_publisher(InertiaStamped, 'inertia', LATCHED)
-    msg = InertiaStamped()
-    msg.inertia.ixx, msg.inertia.iyy, msg.inertia.izz = 1.0, 2.0, 3.0
-    inertia.publish(msg)
+    _latch_inertia(probe)
     odom = probe.publisher(Odometry, 'odom', qos=best_effort)
     probe.handshake(odom, odom_msg(0.01, (0.0, 0.0, 0.0, 1.0), (0.1, 0.0, 0.0)),
                     lambda: bool(answers))
@@ -226,14 +231,10 @@ def test_the_controller_takes_best_effort_odometry_when_told(launch, probe):
 
 def test_the_controller_drops_hostile_odometry_and_exits_zero(launch, probe):
     """A NaN rate or a zero quaternion is not answered (warned, counted); SIGINT exits 0."""
-    from geometry_msgs.msg import InertiaStamped, WrenchStamped
-    from ros_harness import LATCHED, odom_msg
+    from ros_harness import odom_msg
     ctl = launch('rigid_body_dynamics.nodes.controller', '-p', 'control_rate:=0.0', name='ctl')
     answers = probe.subscribe(WrenchStamped, 'torque_cmd')
-    inertia = probe.node.create_publisher(InertiaStamped, 'inertia', LATCHED)
-    msg = InertiaStamped()
-    msg.inertia.ixx, msg.inertia.iyy, msg.inertia.izz = 1.0, 2.0, 3.0
-    inertia.publish(msg)
+    _latch_inertia(probe)
     odom = probe.publisher(Odometry, 'odom')
     probe.handshake(odom, odom_msg(0.01, (0.0, 0.0, 0.0, 1.0), (0.1, 0.0, 0.0)),
                     lambda: bool(answers))
@@ -266,14 +267,10 @@ def test_the_controller_answers_a_state_sent_again_with_the_same_command(launch,
     answer to the first copy is lost when the simulator's subscription did not know the
     controller's publisher yet, and the run must not then wait for ever.
     """
-    from geometry_msgs.msg import InertiaStamped
-    from ros_harness import LATCHED, odom_msg
+    from ros_harness import odom_msg
     launch('rigid_body_dynamics.nodes.controller', name='ctl')        # 100 Hz of stamps
     answers = probe.subscribe(WrenchStamped, 'torque_cmd')
-    inertia = probe.node.create_publisher(InertiaStamped, 'inertia', LATCHED)
-    msg = InertiaStamped()
-    msg.inertia.ixx, msg.inertia.iyy, msg.inertia.izz = 1.0, 2.0, 3.0
-    inertia.publish(msg)
+    _latch_inertia(probe)
     odom = probe.publisher(Odometry, 'odom')
     q = (0.1, 0.0, 0.0, math.sqrt(0.99))
     probe.handshake(odom, odom_msg(0.0, q, (0.1, 0.0, 0.0)), lambda: bool(answers))

@@ -60,9 +60,8 @@ def _spin(nodes, stop):
     thread.start()
     while not stop.is_set():
         time.sleep(SLICE)
-    while thread.is_alive():     # (woken again each slice: a wake must not be lost)
-        wake.trigger()
-        thread.join(SLICE)
+    wake.trigger()
+    thread.join()
     nodes[0].destroy_guard_condition(wake)
     # destroy the executor's guard conditions now, while the context is alive: left to
     # its __del__ they may be collected after the shutdown ("Exception ignored in
