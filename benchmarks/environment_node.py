@@ -19,6 +19,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from nodes import measure_cpu, Probe, sim
 from rigid_body_dynamics.engine import BodySimulation, Disturbances
 from rigid_body_dynamics.physics import Inertia
+from rigid_body_dynamics.physics.dynamics.gyrostat import Wheels
 from rigid_body_dynamics.physics.environment import DipoleField, KeplerOrbit
 
 ROUNDS = 3
@@ -60,7 +61,13 @@ def measure():
 
 
 def engine_steps(steps=20000):
-    """Return RESULTS.md lines: the engine's cost per 1 ms step in each environment (us)."""
+    """
+    Return RESULTS.md lines: the engine's cost per 1 ms step in each environment (us).
+
+    Each environment twice: its models' statements in the generated stages (as the
+    package runs) and the same models called at each stage (``stage_code`` None: how
+    it ran before the statements), the plain body and with four friction wheels.
+    """
     orbit = KeplerOrbit([6878137.0, 0.0, 1.0, 0.3, 0.0, 0.0])
     cases = {'free body (the exact flow)': Disturbances(),
              'constant body torque 1e-3 N m': Disturbances(body=(1e-3, 0.0, 0.0)),
@@ -68,21 +75,38 @@ def engine_steps(steps=20000):
              'gravity gradient, field, residual dipole': Disturbances(
                  orbit=orbit, field=DipoleField(), gravity_gradient=True,
                  residual_dipole=(0.01, -0.02, 0.005))}
-    lines = ['| engine step (1 ms, I = (2, 3, 1.2) kg m^2) | us per step |', '|---|---|']
+    pyramid = [c / 3 ** 0.5 for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1)) for c in g]
+    wheels = Wheels(pyramid, (0.01,) * 4, coulomb=(1e-4,) * 4, viscous=(1e-6,) * 4)
+    lines = ['| engine step (1 ms, I = (2, 3, 1.2) kg m^2) | wheels | us per step, models in '
+             'the stages | us per step, models called at each stage |', '|---|---|---|---|']
     for name, disturbances in cases.items():
-        best = float('inf')
-        for _ in range(3):
-            body = BodySimulation(Inertia((2.0, 3.0, 1.2)), 'exact', 1000.0,
-                                  ((0.0, 0.0, 0.0, 1.0), (0.3, -0.5, 0.8)), publish_every=10,
-                                  disturbances=disturbances)
-            outbox = []
-            start = time.perf_counter()
-            with body.lock:
-                for _ in range(steps):
-                    body.advance(0, outbox)
-            best = min(best, (time.perf_counter() - start) / steps)
-        lines.append(f'| {name} | {best * 1e6:.1f} |')
+        for with_wheels in (False, True):
+            best = {}
+            for called in (False, True):
+                if called and disturbances.orbit is None:
+                    continue
+                best[called] = min(_engine_step(disturbances, with_wheels and wheels, called,
+                                                steps) for _ in range(3))
+            lines.append(f'| {name} | {"four, friction" if with_wheels else "none"} | '
+                         f'{best[False] * 1e6:.1f} | '
+                         + (f'{best[True] * 1e6:.1f} |' if True in best else '- |'))
     return lines
+
+
+def _engine_step(disturbances, wheels, called, steps):
+    """Return the seconds per step of BodySimulation.advance over ``steps`` steps."""
+    body = BodySimulation(Inertia((2.0, 3.0, 1.2)), 'exact', 1000.0,
+                          ((0.0, 0.0, 0.0, 1.0), (0.3, -0.5, 0.8)), publish_every=10,
+                          disturbances=disturbances, wheels=wheels or None,
+                          wheel_speeds=(40.0, -25.0, 10.0, 0.5) if wheels else None)
+    if called and body.plant.field is not None:
+        body.plant.field.stage_code = None
+    outbox = []
+    start = time.perf_counter()
+    with body.lock:
+        for _ in range(steps):
+            body.advance(0, outbox)
+    return (time.perf_counter() - start) / steps
 
 
 if __name__ == '__main__':

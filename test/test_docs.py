@@ -274,6 +274,20 @@ def test_the_python_api_tour_prints_what_it_says():
     assert float(chandler) == pytest.approx(300.0, rel=1e-12)
 
 
+def test_the_torque_model_example_runs_in_the_stages_and_balances_its_energy():
+    """doc/examples/torque_model.py: its model in the stages, at round-off, dissipating."""
+    run = subprocess.run([sys.executable, str(DOC / 'examples' / 'torque_model.py')],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    stages, statements, balance = run.stdout.strip().splitlines()
+    assert stages == 'in the stages: True'
+    assert float(statements.split()[-1]) < 4e-15
+    words = balance.split()
+    omega, change, work = float(words[2]), float(words[7]), float(words[-1])
+    assert omega < 0.5 * (0.3 ** 2 + 0.2 ** 2 + 0.35 ** 2) ** 0.5     # it damps ...
+    assert change < 0.0 and change == pytest.approx(work, rel=1e-6)   # ... and T - T0 = W
+
+
 def test_the_send_torque_example_turns_the_body_as_euler_says(launch, probe):
     """0.1 N m about body z on the symmetric top: omega_3 grows at 0.1 / 1.5 rad/s^2."""
     from geometry_msgs.msg import WrenchStamped

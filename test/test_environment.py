@@ -146,6 +146,114 @@ def test_the_torque_models_against_numpy(rng):
         SpaceEnvironment(orbit, None, [MagneticDipole(m)])
 
 
+class _Drag:
+    """A torque model without stage statements: a damping torque -c omega (N m)."""
+
+    needs = frozenset()
+
+    def __init__(self, c):
+        self.c = c
+
+    def torque(self, t, r, q, omega, env):
+        """Return -c omega (N m, principal frame)."""
+        return tuple(-self.c * w for w in omega)
+
+
+def _environments():
+    """(name, the environment, a state) cases: the models alone and together, two orbits."""
+    moments = (2.0, 3.0, 1.0)
+    eccentric, circular = KeplerOrbit(ELEMENTS), KeplerOrbit(circular_elements(5e5, 0.9))
+    gravity = GravityGradient(moments, MU_EARTH)
+    dipole = MagneticDipole((0.3, -0.1, 0.2))
+    return [('gravity gradient', SpaceEnvironment(eccentric, None, [gravity], epoch=30.0)),
+            ('dipole', SpaceEnvironment(circular, DipoleField(), [dipole])),
+            ('both', SpaceEnvironment(eccentric, DipoleField(rotation_angle=0.4),
+                                      [gravity, dipole], epoch=1e4))]
+
+
+@pytest.mark.parametrize('case', range(3))
+def test_the_stage_statements_give_each_models_own_torque(rng, case):
+    """
+    The statements the integrators put into their stages give what the models' torque() does.
+
+    SpaceEnvironment's call (the compiled statements) against torque_of_models (each
+    model's torque(), the definition) at 50 random states, the attitude not unit (as
+    inside a step), within 4e-15 of the torque's size.
+    """
+    name, env = _environments()[case]
+    assert env.stage_code is not None, name
+    for _ in range(50):
+        q, w, t = 1.3 * rng.normal(size=4), rng.normal(size=3), rng.uniform(0.0, 1e4)
+        expected = np.array(env.torque_of_models(t, *q, *w))
+        np.testing.assert_allclose(env(t, *q, *w), expected, rtol=0,
+                                   atol=4e-15 * np.linalg.norm(expected))
+
+
+@pytest.mark.parametrize('case', range(3))
+@pytest.mark.parametrize('integrator', ['exact', 'rk4', 'wheels exact', 'wheels rk4'])
+def test_a_step_with_the_environment_in_its_stages_is_the_step_that_calls_the_models(
+        case, integrator):
+    """
+    The generated stages with the environment in them against the stages that call it.
+
+    The same environment twice, once with its stage statements and once made to call the
+    models at each stage (stage_code None), 2000 steps of 1 ms under a held body torque
+    (the body alone and with four friction wheels spinning and driven): attitude and
+    angular velocity agree within 1e-13 (the torques agree to round-off, see above; the
+    exact integrator switches to order 8 with the wheels' momentum).
+    """
+    from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator, Wheels
+    name, inlined = _environments()[case]
+    called = _environments()[case][1]
+    called.stage_code = None
+    q0, w0 = quaternions.normalize(np.array([0.1, 0.2, -0.3, 0.9])), (0.3, -0.5, 0.8)
+    wheels = Wheels([c / math.sqrt(3.0) for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
+                     for c in g], (0.01,) * 4, coulomb=(1e-4,) * 4, viscous=(1e-6,) * 4)
+    states = []
+    for env in (inlined, called):
+        if integrator.startswith('wheels'):
+            body = GyrostatIntegrator((2.0, 3.0, 1.0), wheels, 1e-3, q0, w0, (40.0, -25.0, 10.0,
+                                      0.5), method=integrator.split()[1])
+            body.command_motors((0.01, -0.02, 0.005, 0.0))
+        else:
+            body = make_integrator(integrator, (2.0, 3.0, 1.0), 1e-3, q0, w0)
+        for _ in range(2000):
+            body.step((1e-3, 0.0, -2e-3), None, env)
+        states.append(np.r_[body.q, body.omega])
+    np.testing.assert_allclose(states[0], states[1], rtol=0, atol=1e-13)
+    # the body moved, and the environment acted: without it the state is far off
+    plain = make_integrator('rk4', (2.0, 3.0, 1.0), 1e-3, q0, w0)
+    for _ in range(2000 if not integrator.startswith('wheels') else 0):
+        plain.step((1e-3, 0.0, -2e-3))
+    if not integrator.startswith('wheels'):
+        assert np.abs(np.r_[plain.q, plain.omega] - states[0]).max() > 1e-9
+
+
+def test_a_model_without_stage_statements_is_called_at_every_stage():
+    """
+    A torque model with torque() alone is still integrated, to the method's order.
+
+    A damping torque -c omega (no stage_source) beside the gravity gradient: the
+    environment has no stage statements and the integrators call it at each stage. On a
+    body with I1 = I2 = I3 the damping alone decays omega as exp(-c t / I) (the gradient
+    off: no orbit needed). Also: a stage_source whose constants do not carry its prefix is
+    refused.
+    """
+    env = SpaceEnvironment(None, None, [_Drag(0.2)])
+    assert env.stage_code is None
+    body = make_integrator('exact', (1.5, 1.5, 1.5), 1e-2, (0.0, 0.0, 0.0, 1.0), (0.3, -0.2, 0.1))
+    for _ in range(300):
+        body.step((0.0, 0.0, 0.0), None, env)
+    np.testing.assert_allclose(body.omega, np.array([0.3, -0.2, 0.1]) * math.exp(-0.2 * 3.0 / 1.5),
+                               rtol=1e-13)
+
+    class Bad(MagneticDipole):
+        def stage_source(self, p):
+            return {'x': 1.0}, [], ('0.0', '0.0', '0.0')
+    with pytest.raises(ValueError, match='does not start with'):
+        SpaceEnvironment(KeplerOrbit(ELEMENTS), DipoleField(), [Bad((1.0, 0.0, 0.0))])
+
+
 MOMENTS = (2.0, 3.0, 1.0)
 BOX = (0.05, 0.02, 0.03)    # magnetorquer limits (A m^2 per body axis) of the whole-model run
 

@@ -40,7 +40,7 @@ H_w - H_w0 = impulse check the accuracy (tests: to round-off against a tight DOP
 from dataclasses import dataclass
 import math
 
-from .gyrostat_kernels import constants, kernel
+from .gyrostat_kernels import constants, environment_kernel, kernel
 from .integrators import as_torque, ExactIntegrator
 from ..quaternions import rotate_components
 
@@ -299,7 +299,10 @@ class GyrostatIntegrator:
             torque_world = as_torque(torque_world, 'torque_world')
             if not (torque_world[0] or torque_world[1] or torque_world[2]):
                 torque_world = None
-        if field is not None:
+        code = None if field is None else getattr(field, 'stage_code', None)
+        if code is not None:
+            mode = 'environment'
+        elif field is not None:
             mode, torque_world = 'field', torque_world or _ZERO
         elif torque_world is not None:
             mode = 'world'
@@ -317,10 +320,14 @@ class GyrostatIntegrator:
             order = 6 if rho <= self._order6_rate else 8
             if order == 8:
                 count = max(1, math.ceil(rho * self.dt / self.ORDER8_LIMIT))
-        step = self._kernels.get((order, mode))
-        if step is None:
-            step = self._kernels[order, mode] = kernel(order, self.wheels.count, mode,
-                                                       self._friction)
+        if code is not None:
+            step = environment_kernel(order, self.wheels.count, self._friction, code,
+                                      torque_world is not None)
+        else:
+            step = self._kernels.get((order, mode))
+            if step is None:
+                step = self._kernels[order, mode] = kernel(order, self.wheels.count, mode,
+                                                           self._friction)
         h, t0 = self.dt / count, self.time
         q, w, speeds, angles = self.q, self.omega, self.speeds, self.angles
         for i in range(count):

@@ -30,8 +30,9 @@ friction loss, impulse): work = int omega . tau_ext dt (J), motor work = int sum
 Omega_i u_i dt (J), friction loss = int sum_i Omega_i f_i dt (J) and impulse = int R
 tau_ext dt (N m s, world), each by the method's own quadrature of the stage values.
 Modes: ``free`` (no external torque: work and impulse zero), ``body``, ``world``
-(body plus world torque), ``field`` (both plus ``field``); ``friction`` False when
-every wheel's Coulomb and viscous coefficients are zero.
+(body plus world torque), ``field`` (both plus ``field``) and ``environment`` (``field``
+with the environment's statements in the stages, :func:`environment_kernel`);
+``friction`` False when every wheel's Coulomb and viscous coefficients are zero.
 """
 
 import functools
@@ -39,7 +40,7 @@ import math
 
 import numpy as np
 
-from .rk_kernels import BUTCHER6, compile_source, DOP853, literal, RK4
+from .rk_kernels import BUTCHER6, compile_source, DOP853, environment_lines, literal, RK4
 
 #: Tableaux by order.
 TABLEAUX = {4: RK4, 6: BUTCHER6, 8: DOP853}
@@ -47,6 +48,8 @@ TABLEAUX = {4: RK4, 6: BUTCHER6, 8: DOP853}
 _OMEGA = ('wx', 'wy', 'wz')
 _QUAT = ('qx', 'qy', 'qz', 'qw')
 _MATRIX = tuple(f'a{r}{c}' for r in range(1, 4) for c in range(1, 4))
+#: The modes whose torque depends on time and state at every stage.
+_STATE_MODES = ('field', 'environment')
 
 
 def _wheel_names(i, friction):
@@ -91,7 +94,7 @@ def _rotate(qx, qy, qz, qw, vx, vy, vz, out, conjugate=False):
             f'    {out}z = {vz} + {qw} * uz {turn} ({qx} * uy - {qy} * ux)']
 
 
-def _stage_lines(i, node, n, mode, friction):
+def _stage_lines(i, node, n, mode, friction, code=None, nodes=None, world=True):
     """Stage i's derivatives times h: dwx{i} .. dqw{i}, dp{k}_{i}, and its speeds s{k}_{i}."""
     wx, wy, wz, qx, qy, qz, qw = (f'{v}{i}' for v in _OMEGA + _QUAT)
     wheels = range(n)
@@ -115,11 +118,13 @@ def _stage_lines(i, node, n, mode, friction):
         if mode == 'field':
             lines.append(f'    fx, fy, fz = field(t + {literal(node)} * h, {qx}, {qy}, {qz}, '
                          f'{qw}, {wx}, {wy}, {wz})')
+        elif mode == 'environment':
+            lines += environment_lines(code, node, nodes, (qx, qy, qz, qw), (wx, wy, wz))
         extra = ('', '', '')
-        if mode in ('world', 'field'):
+        if mode == 'world' or (mode in _STATE_MODES and world):
             lines += _rotate(qx, qy, qz, qw, 'gwx', 'gwy', 'gwz', 'v', conjugate=True)
             extra = (' + vx', ' + vy', ' + vz')
-        if mode == 'field':
+        if mode in _STATE_MODES:
             extra = tuple(e + f' + f{c}' for e, c in zip(extra, 'xyz'))
         lines += [f'    tx{i} = tbx{extra[0]}', f'    ty{i} = tby{extra[1]}',
                   f'    tz{i} = tbz{extra[2]}']
@@ -155,9 +160,16 @@ def _tuple(items):
     return '(' + ''.join(f'{item}, ' for item in items) + ')'
 
 
-def kernel_source(tableau, n, mode, friction, name='step'):
-    """Python source of one unrolled gyrostat step: ``tableau`` (A rows, b[, c]), n wheels."""
+def kernel_source(tableau, n, mode, friction, name='step', code=None, world=True):
+    """
+    Python source of one unrolled gyrostat step: ``tableau`` (A rows, b[, c]), n wheels.
+
+    Mode ``environment`` takes ``code``, the environment's
+    :class:`~rigid_body_dynamics.physics.environment.stage_code.StageCode`, and
+    ``world``: whether a world torque is held (False: ``tau_world`` is not read).
+    """
     rows, weights = tableau[:2]
+    seen = {}
     nodes = tableau[2] if len(tableau) > 2 else [sum(row) for row in rows]
     wheels = range(n)
     names = ['i1', 'i2', 'i3', *_MATRIX]
@@ -176,8 +188,10 @@ def kernel_source(tableau, n, mode, friction, name='step'):
              + ', '.join(f'h * {a}' for a in _MATRIX)]
     if mode != 'free':
         lines.append('    tbx, tby, tbz = tau')
-    if mode in ('world', 'field'):
+    if mode == 'world' or (mode in _STATE_MODES and world):
         lines.append('    gwx, gwy, gwz = tau_world')
+    if mode == 'environment':
+        lines += code.prologue()
     for k in wheels:
         absolute = f'so{k} + gx{k} * wx0 + gy{k} * wy0 + gz{k} * wz0'
         if friction:        # p_k = J_k (Omega_k + g_k . omega), a stage variable
@@ -195,7 +209,7 @@ def kernel_source(tableau, n, mode, friction, name='step'):
                                    for j, a in enumerate(row) if a != 0)
                 lines.append(f'    {var}{i} = {var}0 + {terms}' if terms else
                              f'    {var}{i} = {var}0')
-        lines += _stage_lines(i, nodes[i], n, mode, friction)
+        lines += _stage_lines(i, nodes[i], n, mode, friction, code, seen, world)
     used = [(j, b) for j, b in enumerate(weights) if b != 0]
     # (each new value is its start plus the step's increment, so that the speeds are
     # rounded once per step as in the relative variables, not through p and back)
@@ -243,3 +257,25 @@ def kernel(order, n, mode, friction):
     source = kernel_source(TABLEAUX[order], n, mode, friction)
     label = f'<gyrostat kernel order {order} {n} wheels {mode}{" friction" if friction else ""}>'
     return compile_source(source, label, {'tanh': math.tanh})
+
+
+_ENVIRONMENT_KERNELS = {}
+
+
+def environment_kernel(order, n, friction, code, world=True):
+    """
+    Return the step of ``order`` for n wheels with the environment ``code`` in its stages.
+
+    ``world``: whether it holds a world torque too. Compiled on first use, one per
+    order, wheel count, friction, environment shape and ``world``.
+    """
+    key = (order, n, friction, code.key, world)
+    step = _ENVIRONMENT_KERNELS.get(key)
+    if step is None:
+        source = kernel_source(TABLEAUX[order], n, 'environment', friction, code=code,
+                               world=world)
+        label = (f'<gyrostat kernel order {order} {n} wheels environment '
+                 f'{len(_ENVIRONMENT_KERNELS)}{" friction" if friction else ""}>')
+        step = _ENVIRONMENT_KERNELS[key] = compile_source(
+            source, label, {'tanh': math.tanh, 'sqrt': math.sqrt})
+    return step

@@ -38,7 +38,7 @@ from abc import ABC, abstractmethod
 import math
 
 from .free_motion import BodyShape
-from .rk_kernels import KERNELS
+from .rk_kernels import environment_kernel, KERNELS
 from ..quaternions import rotate_components
 
 _ZERO = (0.0, 0.0, 0.0)
@@ -50,6 +50,21 @@ REMOVED = {
     'dop853': 'dop853 was removed: `exact` is more accurate under torque at a fraction of '
               'the cost; use integrator `exact`',
 }
+
+
+def field_kernel(field, order, kernels, torque_world):
+    """
+    Return (the step of ``order`` for the stage torque ``field``, the world torque to give it).
+
+    The kernel with the field's statements in its stages when it has them (a
+    :class:`~rigid_body_dynamics.physics.environment.SpaceEnvironment` whose models all
+    give ``stage_source``; without a world torque when ``torque_world`` is None), else
+    ``kernels[order]``, which calls ``field`` at each stage.
+    """
+    code = getattr(field, 'stage_code', None)
+    if code is None:
+        return kernels[order], torque_world or _ZERO
+    return environment_kernel(order, code, torque_world is not None), torque_world
 
 
 def _neumaier(total, comp, value):
@@ -182,7 +197,7 @@ class Integrator(ABC):
         else:
             before = self._lw or self.angular_momentum_world
             work = (self._torque_step(torque, torque_world) if field is None else
-                    self._field_step(torque, torque_world or _ZERO, field))
+                    self._field_step(torque, torque_world, field))
             self._work = _neumaier(*self._work, work)
             after = self._lw = self.angular_momentum_world
             self._impulse = [_neumaier(*acc, a - b)
@@ -204,7 +219,7 @@ class Integrator(ABC):
 
     @abstractmethod
     def _field_step(self, torque, torque_world, field):
-        """Advance by dt under the held torques plus ``field``; return the work (J)."""
+        """Advance by dt under the held torques (world: None or N m) plus ``field``; work (J)."""
 
 
 class RK4Integrator(Integrator):
@@ -218,7 +233,7 @@ class RK4Integrator(Integrator):
     def _free_step(self):
         self.q, self.omega, _ = self._free(self._inv, self.q, self.omega, self.dt, None, None)
 
-    _field = staticmethod(KERNELS[(4, 'field')])
+    _field = {4: KERNELS[(4, 'field')]}
 
     def _torque_step(self, torque, torque_world):
         kernel = self._body if torque_world is None else self._world
@@ -227,8 +242,9 @@ class RK4Integrator(Integrator):
         return work
 
     def _field_step(self, torque, torque_world, field):
-        self.q, self.omega, work = self._field(self._inv, self.q, self.omega, self.dt, torque,
-                                               torque_world, field, self.time)
+        kernel, torque_world = field_kernel(field, 4, self._field, torque_world)
+        self.q, self.omega, work = kernel(self._inv, self.q, self.omega, self.dt, torque,
+                                          torque_world, field, self.time)
         return work
 
 
@@ -264,7 +280,7 @@ class ExactIntegrator(Integrator):
     name = 'exact'
     ORDER6_LIMIT = 0.01
     ORDER8_LIMIT = 0.08
-    _kernels = {mode: (KERNELS[(6, mode)], KERNELS[(8, mode)])
+    _kernels = {mode: {6: KERNELS[(6, mode)], 8: KERNELS[(8, mode)]}
                 for mode in ('free', 'body', 'world', 'field')}
 
     _lazy = False       # whether q and omega are still to be read off the free flow
@@ -362,8 +378,9 @@ class ExactIntegrator(Integrator):
         self._segment = None
         t = self.time
         f = field(t, *self.q, *self.omega)
-        largest = (max(abs(torque[0] + f[0]), abs(torque[1] + f[1]), abs(torque[2] + f[2]))
-                   + max(abs(torque_world[0]), abs(torque_world[1]), abs(torque_world[2])))
+        largest = max(abs(torque[0] + f[0]), abs(torque[1] + f[1]), abs(torque[2] + f[2]))
+        if torque_world is not None:
+            largest += max(abs(torque_world[0]), abs(torque_world[1]), abs(torque_world[2]))
         return self._rk('field', torque, torque_world, math.sqrt(largest / self._i_min),
                         field)
 
@@ -376,15 +393,21 @@ class ExactIntegrator(Integrator):
         """
         wx, wy, wz = self.omega
         t = self.time
+        kernels = self._kernels[mode]
         spare = self._order6_rate - torque_rate     # what |omega| may be for order 6
         if spare > 0.0 and wx * wx + wy * wy + wz * wz <= spare * spare:
-            self.q, self.omega, work = self._kernels[mode][0](
+            order6 = kernels[6]
+            if field is not None:
+                order6, torque_world = field_kernel(field, 6, kernels, torque_world)
+            self.q, self.omega, work = order6(
                 self._inv, self.q, self.omega, self.dt, torque, torque_world, field, t)
             return work
         rho = math.sqrt(wx * wx + wy * wy + wz * wz) + torque_rate
         n = max(1, math.ceil(rho * self.dt / self.ORDER8_LIMIT))
         h = self.dt / n
-        order8 = self._kernels[mode][1]
+        order8 = kernels[8]
+        if field is not None:
+            order8, torque_world = field_kernel(field, 8, kernels, torque_world)
         q, w, work = self.q, self.omega, 0.0
         for k in range(n):
             q, w, dw = order8(self._inv, q, w, h, torque, torque_world, field, t + k * h)

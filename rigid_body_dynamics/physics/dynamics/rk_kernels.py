@@ -31,11 +31,16 @@ only), ``world`` (tau plus tau_world) and ``field`` (tau plus tau_world plus
 a torque that depends on time and state, ``field(t_stage, qx, qy, qz, qw, wx, wy,
 wz)`` -> body torque (N m), evaluated at every stage at t_stage = t + c_i h, so a
 gravity-gradient or magnetic torque is integrated to the method's order, not
-held; :class:`~.environment.SpaceEnvironment` is one).
+held; :class:`~.environment.SpaceEnvironment` is one). A fifth,
+``environment`` (:func:`environment_kernel`), is ``field`` with the environment's
+torque written into each stage as statements
+(:mod:`~rigid_body_dynamics.physics.environment.stage_code`) instead of called:
+one kernel per environment shape, compiled on first use.
 """
 
 from fractions import Fraction as F
 import linecache
+import math
 
 from . import dop853_tableau
 
@@ -61,6 +66,8 @@ DOP853 = (dop853_tableau.A, dop853_tableau.B, dop853_tableau.C)
 
 _OMEGA = ('wx', 'wy', 'wz')
 _QUAT = ('qx', 'qy', 'qz', 'qw')
+#: The modes whose torque depends on time and state at every stage.
+_STATE_MODES = ('field', 'environment')
 
 
 def literal(coefficient):
@@ -68,15 +75,42 @@ def literal(coefficient):
     return repr(float(coefficient))
 
 
-def _derivative_lines(i, mode, node):
-    """Scaled derivatives h f(stage i at time node c_i): dwx{i} ... dqw{i}, the torque."""
+def environment_lines(code, node, nodes, q, w):
+    """
+    Statements of the environment ``code`` (a StageCode) at a stage of ``node``: fx, fy, fz.
+
+    ``nodes`` maps the nodes seen so far in the step to their index (updated here):
+    a node's world quantities are computed once. ``q``, ``w``: the stage's attitude and
+    angular velocity names.
+    """
+    lines = []
+    j = nodes.get(node)
+    if j is None:
+        j = nodes[node] = len(nodes)
+        lines += code.node_lines(j, f't + {literal(node)} * h')
+    return lines + code.stage_lines(j, q, w)
+
+
+def _derivative_lines(i, mode, node, code=None, nodes=None, world=True):
+    """
+    Scaled derivatives h f(stage i at time node c_i): dwx{i} ... dqw{i}, the torque.
+
+    ``world`` False: mode ``environment`` without a world torque (none to rotate).
+    """
     wx, wy, wz, qx, qy, qz, qw = (f'{n}{i}' for n in _OMEGA + _QUAT)
-    fx, fy, fz = (' + fx', ' + fy', ' + fz') if mode == 'field' else ('', '', '')
+    fx, fy, fz = (' + fx', ' + fy', ' + fz') if mode in _STATE_MODES else ('', '', '')
     lines = []
     if mode == 'field':
         lines.append(f'    fx, fy, fz = field(t + {literal(node)} * h, {qx}, {qy}, {qz}, {qw}, '
                      f'{wx}, {wy}, {wz})')
-    if mode in ('world', 'field'):
+    elif mode == 'environment':
+        lines += environment_lines(code, node, nodes, (qx, qy, qz, qw), (wx, wy, wz))
+    if mode == 'environment' and not world:
+        lines += [f'    tx{i} = tbx + fx', f'    ty{i} = tby + fy', f'    tz{i} = tbz + fz',
+                  f'    dwx{i} = hc1 * {wy} * {wz} + hj1 * tx{i}',
+                  f'    dwy{i} = hc2 * {wz} * {wx} + hj2 * ty{i}',
+                  f'    dwz{i} = hc3 * {wx} * {wy} + hj3 * tz{i}']
+    elif mode in ('world', *_STATE_MODES):
         # tau_b = tau + R(q)^T tau_world: rotate by the conjugate (-qx, -qy, -qz, qw)
         lines += [
             f'    ux = 2.0 * (-{qy} * gz + {qz} * gy)',
@@ -106,10 +140,17 @@ def _derivative_lines(i, mode, node):
     return lines
 
 
-def kernel_source(tableau, mode, name='step'):
-    """Python source of one unrolled step for ``tableau`` = (A rows, b[, c]) and ``mode``."""
+def kernel_source(tableau, mode, name='step', code=None, world=True):
+    """
+    Python source of one unrolled step for ``tableau`` = (A rows, b[, c]) and ``mode``.
+
+    Mode ``environment`` takes ``code``, the environment's
+    :class:`~rigid_body_dynamics.physics.environment.stage_code.StageCode`, and
+    ``world``: whether a world torque is held (False: ``tau_world`` is not read).
+    """
     rows, weights = tableau[:2]
     nodes = tableau[2] if len(tableau) > 2 else [sum(row) for row in rows]
+    seen = {}
     lines = [f'def {name}(inv, q, w, h, tau, tau_world, field=None, t=0.0):',
              '    c1, c2, c3, j1, j2, j3 = inv',
              '    qx0, qy0, qz0, qw0 = q',
@@ -119,10 +160,12 @@ def kernel_source(tableau, mode, name='step'):
     if mode == 'body':
         lines += ['    tbx, tby, tbz = tau',
                   '    ht1, ht2, ht3 = h * tbx * j1, h * tby * j2, h * tbz * j3']
-    elif mode in ('world', 'field'):
+    elif mode in ('world', *_STATE_MODES):
         lines += ['    tbx, tby, tbz = tau',
-                  '    gx, gy, gz = tau_world',
+                  *(['    gx, gy, gz = tau_world'] if world or mode != 'environment' else []),
                   '    hj1, hj2, hj3 = h * j1, h * j2, h * j3']
+    if mode == 'environment':
+        lines += code.prologue()
     for i, row in enumerate(rows):
         if i > 0:
             for var in _OMEGA + _QUAT:
@@ -130,7 +173,7 @@ def kernel_source(tableau, mode, name='step'):
                                    for j, a in enumerate(row) if a != 0)
                 lines.append(f'    {var}{i} = {var}0 + {terms}' if terms else
                              f'    {var}{i} = {var}0')
-        lines += _derivative_lines(i, mode, nodes[i])
+        lines += _derivative_lines(i, mode, nodes[i], code, seen, world)
     used = [(j, b) for j, b in enumerate(weights) if b != 0]
     for var in _OMEGA + _QUAT:
         terms = ' + '.join(f'{literal(b)} * d{var}{j}' for j, b in used)
@@ -168,6 +211,27 @@ def compile_source(source, filename, namespace=None):
 def compile_kernel(tableau, mode, label=''):
     """Compile :func:`kernel_source` into a function; its source goes to linecache."""
     return compile_source(kernel_source(tableau, mode), f'<rk kernel {label} {mode}>')
+
+
+_ENVIRONMENT_KERNELS = {}
+
+
+def environment_kernel(order, code, world=True):
+    """
+    Return the step of ``order`` (4, 6 or 8) with the environment ``code`` in its stages.
+
+    ``world``: whether it holds a world torque too. Compiled on first use, one per
+    order, environment shape (``code.key``) and ``world``.
+    """
+    key = (order, code.key, world)
+    step = _ENVIRONMENT_KERNELS.get(key)
+    if step is None:
+        tableau = {4: RK4, 6: BUTCHER6, 8: DOP853}[order]
+        step = _ENVIRONMENT_KERNELS[key] = compile_source(
+            kernel_source(tableau, 'environment', code=code, world=world),
+            f'<rk kernel order {order} environment {len(_ENVIRONMENT_KERNELS)}>',
+            {'sqrt': math.sqrt})
+    return step
 
 
 #: Kernels by (order, mode).

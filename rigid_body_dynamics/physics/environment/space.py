@@ -5,13 +5,19 @@ The space environment of one body: orbit, magnetic field and the torque models t
 ``field`` argument): at simulated time t it finds the position on the orbit
 and the magnetic field there, turns both into the principal frame of the body's
 attitude at that stage, and sums the torques of its models
-(:mod:`.torque_models`). It knows no model by name. :class:`Disturbances` is what a body's
-environment is, as data (what the nodes' parameters say).
+(:mod:`.torque_models`). It knows no model by name. When every model gives its
+torque as statements (:mod:`.stage_code`), the integrators put them into their
+generated stages, and a call runs the same statements compiled.
+:class:`Disturbances` is what a body's environment is, as data (what the nodes'
+parameters say).
 """
 
 from dataclasses import dataclass
+import math
 
 from .orbit import R_EARTH
+from .stage_code import stage_code, torque_source
+from ..dynamics.rk_kernels import compile_source
 
 _ZERO = (0.0, 0.0, 0.0)
 
@@ -55,6 +61,11 @@ class SpaceEnvironment:
 
     Called as ``env(t, qx, qy, qz, qw, wx, wy, wz)`` (t in s, q principal ->
     world, omega rad/s principal) it returns the summed torque (N m, principal).
+    ``stage_code`` is the models as stage statements (None when a model has no
+    ``stage_source``), ``constants`` their parameters, read when it is made: a
+    model's parameter changed later (``Magnetorquers.set_dipole``) takes effect in a
+    new SpaceEnvironment, as :class:`~rigid_body_dynamics.physics.dynamics.plant.Plant`
+    makes on every change.
     """
 
     def __init__(self, orbit=None, field=None, models=(), epoch=0.0):
@@ -76,48 +87,89 @@ class SpaceEnvironment:
         self._field = 'field' in needs and field is not None
         self.epoch = float(epoch)
         self.env = Surroundings()
-        # (r, B) in the world frame by time: an RK step evaluates a few times more than
-        # once (Butcher's order 6 has 5 distinct nodes in 7 stages, and a step's end is the
-        # next one's start), and they depend on the time alone
+        # the world quantities by integrator time: an RK step evaluates a few times more than
+        # once (a step's end is the next one's start, and the order is chosen at the start)
         self._world = {}
         self._last = (None, None)      # (arguments, torque) of the last call
+        #: the models as stage statements (None: one has none; they are then called)
+        self.stage_code = stage_code(self.models, self._position, self._field)
+        #: the models' constants in the order of ``stage_code.names``, read now
+        self.constants = self.stage_code.values if self.stage_code is not None else ()
+        self._compiled = compiled_torque(self.stage_code) if self.stage_code is not None \
+            else None
+
+    def world_at(self, t):
+        """
+        Return (r (m, 3), norm(r)^2 (m^2), B (T, 3)), world frame, at integrator time t (s).
+
+        A flat tuple; r and its norm only when the models need the position, B only
+        with a field (see :class:`~.stage_code.StageCode`).
+        """
+        world = self._world.get(t)
+        if world is None:
+            if not self._position:
+                return ()
+            if len(self._world) > 32:
+                self._world.clear()
+            s = t + self.epoch
+            r = self.orbit.position(s)
+            world = r + (r[0] * r[0] + r[1] * r[1] + r[2] * r[2],)
+            if self._field:
+                world += self.field.world(s, r)
+            world = self._world[t] = world
+        return world
 
     def surroundings(self, t, q):
-        """Fill and return the :class:`Surroundings` at simulated time t (s) and attitude q."""
+        """Fill and return the :class:`Surroundings` at integrator time t (s) and attitude q."""
         env = self.env
         if self._position:
-            world = self._world.get(t)
-            if world is None:
-                if len(self._world) > 32:
-                    self._world.clear()
-                r = self.orbit.position(t)
-                world = self._world[t] = (r, self.field.world(t, r) if self._field else None)
-            env.r_world, env.b_world = world
-            env.r_body = _to_body(*q, world[0])
+            world = self.world_at(t)
+            env.r_world = world[:3]
+            env.r_body = _to_body(*q, env.r_world)
             if self._field:
-                env.b_body = _to_body(*q, world[1])
+                env.b_world = world[4:]
+                env.b_body = _to_body(*q, env.b_world)
         return env
 
     def __call__(self, t, qx, qy, qz, qw, wx=0.0, wy=0.0, wz=0.0):
         """Return the summed torque (N m, principal frame) at integrator time t (s)."""
+        if self._compiled is not None:
+            return self._compiled(self, t, qx, qy, qz, qw, wx, wy, wz)
         args = (t, qx, qy, qz, qw, wx, wy, wz)
         last, torque = self._last
         if args == last:          # (the integrator asks at a step's start, then its stage 0)
             return torque
-        torque = self._torque(t + self.epoch, qx, qy, qz, qw, wx, wy, wz)
+        torque = self.torque_of_models(t, qx, qy, qz, qw, wx, wy, wz)
         self._last = (args, torque)
         return torque
 
-    def _torque(self, t, qx, qy, qz, qw, wx, wy, wz):
-        """Return the summed torque (N m, principal) at simulated time t (s)."""
+    def torque_of_models(self, t, qx, qy, qz, qw, wx=0.0, wy=0.0, wz=0.0):
+        """
+        Return the summed torque (N m, principal) at integrator time t (s), model by model.
+
+        Each model's ``torque()`` at simulated time t + epoch: the definition the stage
+        statements are held to.
+        """
         q = (qx, qy, qz, qw)
         env = self.surroundings(t, q)
-        r, omega = env.r_world, (wx, wy, wz)
+        t, r, omega = t + self.epoch, env.r_world, (wx, wy, wz)
         tx = ty = tz = 0.0
         for model in self.models:
             a, b, c = model.torque(t, r, q, omega, env)
             tx, ty, tz = tx + a, ty + b, tz + c
         return tx, ty, tz
+
+
+_COMPILED = {}
+
+
+def compiled_torque(code):
+    """Return the compiled :func:`~.stage_code.torque_source` of a StageCode (cached by key)."""
+    function = _COMPILED.get(code.key)
+    if function is None:
+        function = _COMPILED[code.key] = compile_source(
+            torque_source(code), f'<environment torque {len(_COMPILED)}>', {'sqrt': math.sqrt})
+    return function
 
 
 @dataclass(frozen=True)

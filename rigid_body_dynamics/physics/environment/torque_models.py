@@ -19,7 +19,9 @@ when it is built (``Inertia.to_principal`` turns a body-frame vector).
 Adding a model is one class here (or in a file of its own) and one entry in
 the simulator's parameter table: :class:`~.space.SpaceEnvironment` sums
 whatever models it is given and knows none by name (as Basilisk's hub sums its
-dynamic effectors).
+dynamic effectors). A model may also give its torque as statements for the
+generated integrator stages (``stage_source(prefix)``, see :mod:`.stage_code`),
+which makes it cost its arithmetic; without that it is called at every stage.
 
 The commanded torque and the constant disturbances are held over a step (a
 zero-order hold), so the integrators take them as their held body and world
@@ -54,6 +56,15 @@ class GravityGradient:
         i1, i2, i3 = self.moments
         return (k * (i3 - i2) * ry * rz, k * (i1 - i3) * rz * rx, k * (i2 - i1) * rx * ry)
 
+    def stage_source(self, p):
+        """Return the torque as stage statements (:mod:`.stage_code`): constants, lines, torque."""
+        i1, i2, i3 = self.moments
+        constants = {f'{p}mu3': 3.0 * self.mu, f'{p}d1': i3 - i2, f'{p}d2': i1 - i3,
+                     f'{p}d3': i2 - i1}
+        lines = [f'{p}k = {p}mu3 / (r_rr * r_rr * sqrt(r_rr))']
+        return constants, lines, (f'{p}k * {p}d1 * r_by * r_bz', f'{p}k * {p}d2 * r_bz * r_bx',
+                                  f'{p}k * {p}d3 * r_bx * r_by')
+
 
 class MagneticDipole:
     """
@@ -74,6 +85,13 @@ class MagneticDipole:
         mx, my, mz = self.dipole
         bx, by, bz = env.b_body
         return (my * bz - mz * by, mz * bx - mx * bz, mx * by - my * bx)
+
+    def stage_source(self, p):
+        """Return the torque as stage statements (:mod:`.stage_code`): constants, lines, torque."""
+        mx, my, mz = self.dipole
+        return ({f'{p}x': mx, f'{p}y': my, f'{p}z': mz}, [],
+                (f'{p}y * b_bz - {p}z * b_by', f'{p}z * b_bx - {p}x * b_bz',
+                 f'{p}x * b_by - {p}y * b_bx'))
 
 
 class Magnetorquers(MagneticDipole):

@@ -1,0 +1,137 @@
+"""
+The environment's torque as straight-line statements, for the generated Runge-Kutta stages.
+
+The integrators' kernels (:mod:`~rigid_body_dynamics.physics.dynamics.rk_kernels`,
+:mod:`~rigid_body_dynamics.physics.dynamics.gyrostat_kernels`) are generated as
+scalar statements, because in pure Python a step then costs what its arithmetic
+costs. A torque model called at every stage (``torque(t, r, q, omega, env)``)
+costs a call, the shared quantities' call and a tuple per stage, several times its
+arithmetic. :class:`StageCode` puts the models' arithmetic into the stage instead:
+
+- at each distinct node t + c h of the step, one call ``world(t + c h)``
+  (:meth:`SpaceEnvironment.world_at <.space.SpaceEnvironment.world_at>`) gives
+  the world-frame position r (m), its squared norm and the field B (T): they
+  depend on time alone;
+- at each stage, r and B are turned into the principal frame of the stage's
+  attitude (not quite unit inside a step: the rotation of q / norm(q), as
+  :func:`.space._to_body`), and each model's statements give its torque (N m,
+  principal frame), summed into ``fx, fy, fz``.
+
+A model takes part by a method ``stage_source(prefix)`` returning
+``(constants, lines, torque)``: ``constants`` a dict of its parameters by name
+(each name starting with ``prefix``), read when the environment is made;
+``lines`` statements that may read ``r_bx, r_by, r_bz`` (position, principal
+frame, m), ``r_rr`` (its squared norm, m^2), ``b_bx, b_by, b_bz`` (field,
+principal frame, T), ``o_x, o_y, o_z`` (the stage's angular velocity, rad/s,
+principal frame; the model's ``needs`` has 'rate'), ``sqrt`` and its constants,
+and set names starting with ``prefix``; ``torque`` three expressions of its torque
+components. The model's ``torque()`` stays its definition (tests hold the two to
+round-off). An environment with a model that has no ``stage_source`` (one that
+needs the time, say) is evaluated through the models' ``torque()`` at every stage,
+as before: slower, never different.
+"""
+
+_STAGE_NAMES = ('r_bx', 'r_by', 'r_bz', 'r_rr', 'b_bx', 'b_by', 'b_bz')
+
+
+class StageCode:
+    """
+    The statements of an environment's summed torque at one stage, and their constants.
+
+    ``models`` (each with ``stage_source``, see the module docstring),
+    ``position``, ``field`` and ``rate``: whether the stages need the position, the
+    field and the angular velocity. ``key`` identifies the generated source (the same key, the same
+    statements: one compiled kernel serves every environment of that shape);
+    ``names`` and ``values`` the constants, which a kernel unpacks from the
+    environment's ``constants`` at each step.
+    """
+
+    def __init__(self, models, position, field, rate=False):
+        constants, lines, sums = {}, [], ([], [], [])
+        for n, model in enumerate(models):
+            prefix = f'm{n}_'
+            values, statements, torque = model.stage_source(prefix)
+            for name in values:
+                if not name.startswith(prefix):
+                    raise ValueError(f'{type(model).__name__}.stage_source: constant {name!r} '
+                                     f'does not start with {prefix!r}')
+            constants.update(values)
+            lines += statements
+            for total, term in zip(sums, torque):
+                total.append(f'({term})')
+        self.position, self.field, self.rate = bool(position), bool(field), bool(rate)
+        self.names = tuple(constants)
+        self.values = tuple(float(v) for v in constants.values())
+        self.lines = tuple(lines)
+        self.torque = tuple(' + '.join(terms) or '0.0' for terms in sums)
+        self.key = (self.position, self.field, self.rate, self.names, self.lines, self.torque)
+
+    def world_names(self, j):
+        """Names of node j's world quantities: r (m), its squared norm, and B (T)."""
+        names = [f'r_wx{j}', f'r_wy{j}', f'r_wz{j}', f'r_rr{j}'] if self.position else []
+        return names + ([f'b_wx{j}', f'b_wy{j}', f'b_wz{j}'] if self.field else [])
+
+    def prologue(self, indent='    '):
+        """Statements once per step: ``world`` and the constants from the environment ``field``."""
+        lines = [f'{indent}world = field.world_at']
+        if self.names:
+            comma = ',' if len(self.names) == 1 else ''
+            lines.append(f'{indent}{", ".join(self.names)}{comma} = field.constants')
+        return lines
+
+    def node_lines(self, j, time, indent='    '):
+        """Statements for node j at time expression ``time``: its world quantities."""
+        names = self.world_names(j)
+        if not names:
+            return []
+        comma = ',' if len(names) == 1 else ''
+        return [f'{indent}{", ".join(names)}{comma} = world({time})']
+
+    def stage_lines(self, j, q, w, indent='    '):
+        """
+        Statements setting ``fx, fy, fz`` (N m, principal frame) at a stage of node j.
+
+        ``q``: the names of the stage's attitude (x, y, z, w; need not be unit), ``w``
+        of its angular velocity.
+        """
+        qx, qy, qz, qw = q
+        lines = [f'o_x, o_y, o_z = {", ".join(w)}'] if self.rate else []
+        if self.position or self.field:
+            lines.append(f's_q = 2.0 / ({qx} * {qx} + {qy} * {qy} + {qz} * {qz} + {qw} * {qw})')
+        for kind, on in (('r', self.position), ('b', self.field)):
+            if not on:
+                continue
+            vx, vy, vz = f'{kind}_wx{j}', f'{kind}_wy{j}', f'{kind}_wz{j}'
+            # R(q)^T v for q / norm(q): v + qw u - qv x u, u = 2 (v x qv) / norm(q)^2
+            lines += [f's_ux = s_q * ({vy} * {qz} - {vz} * {qy})',
+                      f's_uy = s_q * ({vz} * {qx} - {vx} * {qz})',
+                      f's_uz = s_q * ({vx} * {qy} - {vy} * {qx})',
+                      f'{kind}_bx = {vx} + {qw} * s_ux - ({qy} * s_uz - {qz} * s_uy)',
+                      f'{kind}_by = {vy} + {qw} * s_uy - ({qz} * s_ux - {qx} * s_uz)',
+                      f'{kind}_bz = {vz} + {qw} * s_uz - ({qx} * s_uy - {qy} * s_ux)']
+        if self.position:
+            lines.append(f'r_rr = r_rr{j}')
+        lines += list(self.lines)
+        lines += [f'fx = {self.torque[0]}', f'fy = {self.torque[1]}', f'fz = {self.torque[2]}']
+        return [indent + line for line in lines]
+
+
+def stage_code(models, position, field):
+    """Return the :class:`StageCode` of ``models``, or None when one has no ``stage_source``."""
+    if not all(hasattr(model, 'stage_source') for model in models):
+        return None
+    return StageCode(models, position, field, any('rate' in model.needs for model in models))
+
+
+def torque_source(code, name='torque'):
+    """
+    Source of ``name(field, t, qx, qy, qz, qw, wx, wy, wz)``: the summed torque at one state.
+
+    The same statements as a stage (``field`` the environment, t its integrator time, s),
+    so that the torque at a step's start, which sets the step's order, costs one node.
+    """
+    lines = [f'def {name}(field, t, qx, qy, qz, qw, wx=0.0, wy=0.0, wz=0.0):',
+             *code.prologue(), *code.node_lines(0, 't'),
+             *code.stage_lines(0, ('qx', 'qy', 'qz', 'qw'), ('wx', 'wy', 'wz')),
+             '    return fx, fy, fz']
+    return '\n'.join(lines) + '\n'
