@@ -197,15 +197,15 @@ def test_a_step_with_the_environment_in_its_stages_is_the_step_that_calls_the_mo
     The generated stages with the environment in them against the stages that call it.
 
     The same environment twice, once with its stage statements and once made to call the
-    models at each stage (stage_code None), 2000 steps of 1 ms under a held body torque
+    models at each stage (stages=False), 2000 steps of 1 ms under a held body torque
     (the body alone and with four friction wheels spinning and driven): attitude and
     angular velocity agree within 1e-13 (the torques agree to round-off, see above; the
     exact integrator switches to order 8 with the wheels' momentum).
     """
     from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator, Wheels
     name, inlined = _environments()[case]
-    called = _environments()[case][1]
-    called.stage_code = None
+    called = SpaceEnvironment(inlined.orbit, inlined.field, inlined.models, inlined.epoch,
+                              stages=False)
     q0, w0 = quaternions.normalize(np.array([0.1, 0.2, -0.3, 0.9])), (0.3, -0.5, 0.8)
     wheels = Wheels([c / math.sqrt(3.0) for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
                      for c in g], (0.01,) * 4, coulomb=(1e-4,) * 4, viscous=(1e-6,) * 4)

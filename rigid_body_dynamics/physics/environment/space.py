@@ -57,7 +57,8 @@ class SpaceEnvironment:
     protocol of :mod:`.torque_models`). ``epoch`` (s) is added to the
     integrator's time (the simulated time at the integrator's time 0).
     A model that needs the position without an orbit, or the field without one,
-    is refused with ValueError.
+    is refused with ValueError. ``stages`` False calls the models at every stage even
+    when they have statements (to compare the two).
 
     Called as ``env(t, qx, qy, qz, qw, wx, wy, wz)`` (t in s, q principal ->
     world, omega rad/s principal) it returns the summed torque (N m, principal).
@@ -68,7 +69,7 @@ class SpaceEnvironment:
     makes on every change.
     """
 
-    def __init__(self, orbit=None, field=None, models=(), epoch=0.0):
+    def __init__(self, orbit=None, field=None, models=(), epoch=0.0, stages=True):
         self.orbit, self.field, self.models = orbit, field, tuple(models)
         needs = set()
         for model in self.models:
@@ -92,7 +93,8 @@ class SpaceEnvironment:
         self._world = {}
         self._last = (None, None)      # (arguments, torque) of the last call
         #: the models as stage statements (None: one has none; they are then called)
-        self.stage_code = stage_code(self.models, self._position, self._field)
+        self.stage_code = stage_code(self.models, self._position, self._field) if stages \
+            else None
         #: the models' constants in the order of ``stage_code.names``, read now
         self.constants = self.stage_code.values if self.stage_code is not None else ()
         self._compiled = compiled_torque(self.stage_code) if self.stage_code is not None \
