@@ -102,10 +102,10 @@ def engine_steps(steps=20000):
         f'{name} {inlined:.1f}x in the stages, {called:.1f}x called'
         for name, inlined, called in ratios) + '. What the statements leave: the orbit and '
         'the field at each distinct stage time (5 in an order-6 step; they depend on time '
-        'alone), and the turn of the position and the field into each stage\'s attitude. '
-        'The node\'s CPU moves from run to run and day to day on this 2-core virtual '
-        'machine (the free body alone measured 0.034 to 0.064 of a core in three runs on '
-        '2026-12-03), so the engine\'s step is the steadier figure.']
+        'alone), and the turn of the position and the field into the attitude of each '
+        'stage. The CPU of the node moves from run to run and day to day on this 2-core '
+        'virtual machine (the free body alone measured 0.034 to 0.064 of a core in three '
+        'runs on 2026-12-03), so the step of the engine is the steadier figure.']
 
 
 def _engine_step(disturbances, wheels, called, steps):
