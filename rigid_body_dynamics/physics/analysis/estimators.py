@@ -240,7 +240,7 @@ def crossing_times(t, x, direction=1, max_bracket=math.inf):
 
 def _crossing_spacing(t, x, direction, max_bracket):
     """
-    Least-squares spacing (s) of consecutive zero crossings, and how many were fitted.
+    Return the least-squares spacing (s) of consecutive zero crossings.
 
     Each crossing keeps its number in the sequence, and one bracketed by samples more than
     ``max_bracket`` s apart (default: 3 times the median interval between samples) is left
@@ -258,7 +258,7 @@ def _crossing_spacing(t, x, direction, max_bracket):
     if k.size < 2:
         raise ValueError(f'{times.size} zero crossings, {times.size - k.size} of them across a '
                          'gap in the samples: fewer than two to fit')
-    return float(np.polyfit(k, times[k], 1)[0]), int(k.size)
+    return float(np.polyfit(k, times[k], 1)[0])
 
 
 def crossing_period(t, x, direction=1, max_bracket=None):
@@ -269,7 +269,7 @@ def crossing_period(t, x, direction=1, max_bracket=None):
     across a gap in the samples is left out (``max_bracket``: see :func:`_crossing_spacing`).
     Raises ValueError with fewer than two crossings.
     """
-    spacing, _ = _crossing_spacing(t, x, direction, max_bracket)
+    spacing = _crossing_spacing(t, x, direction, max_bracket)
     return spacing * (2.0 if direction == 0 else 1.0)
 
 
@@ -321,6 +321,6 @@ def flip_interval(t, omega, axis, max_bracket=None):
     out (``max_bracket``: see :func:`_crossing_spacing`).
     """
     try:
-        return _crossing_spacing(t, np.asarray(omega, dtype=float)[:, axis], 0, max_bracket)[0]
+        return _crossing_spacing(t, np.asarray(omega, dtype=float)[:, axis], 0, max_bracket)
     except ValueError as err:
         raise ValueError(str(err).replace('zero crossings', 'flips')) from None
