@@ -20,7 +20,12 @@ def test_demo_runs_both_nodes_and_prints_the_analyzers_findings():
     assert out.returncode == 0, out.stderr
     assert 'started attitude_simulator' in out.stdout and 'attitude_analyzer finds' in out.stdout
     assert 'exit codes 0, 0' in out.stdout
-    assert 'WARN' not in out.stdout + out.stderr      # start-up is no missed deadline
+    # Start-up is no missed deadline (on a fake clock: test_engine's
+    # test_the_schedule_starts_when_its_thread_does_not_at_construction). Here the only
+    # warning allowed is the one a loaded machine earns: a stall of the simulator, said.
+    warnings = [line for line in (out.stdout + out.stderr).splitlines()
+                if 'WARN' in line and 'cannot keep up with real_time_factor' not in line]
+    assert not warnings, warnings
     errors = _relative_errors(out.stdout)
     assert len(errors) == 2 and max(errors) < 1e-9
     assert 'conservation: conserved' in out.stdout
