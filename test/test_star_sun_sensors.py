@@ -18,8 +18,8 @@ from rigid_body_dynamics.physics.environment import (circular_elements, in_shado
                                                      KeplerOrbit, R_EARTH, Sun)
 from rigid_body_dynamics.physics.sensors import (BodyTruth, Gyro, GyroErrors, Sky, StarTracker,
                                                  SunSensor)
-from scipy import stats
 from scipy.spatial.transform import Rotation
+import stat_checks
 
 EPS_2026 = 23.439 - 4e-7 * (julian_date('2026-06-21T08:24:00Z') - 2451545.0)
 
@@ -89,41 +89,80 @@ def _truth(q, position=None, sun=(1.0, 0.0, 0.0)):
     return BodyTruth(tuple(q), (0.0, 0.0, 0.0), position, Sky(sun=Sun(fixed=sun)))
 
 
+NOISE = np.array([2e-5, 3e-5, 1.5e-4])
+MOUNT = Rotation.from_euler('xyz', [0.3, -1.1, 0.7])
+MISALIGNMENT = np.array([1e-4, -2e-4, 5e-4])
+
+
+def _tracker_readings(seed, n):
+    """Return (truths, readings) of n star tracker readings of random attitudes."""
+    tracker = StarTracker(10.0, NOISE, MOUNT.as_quat(), MISALIGNMENT)
+    rng = np.random.default_rng(seed)
+    truths = Rotation.random(n, random_state=seed + 7)
+    return truths, [tracker.sample(_truth(q), 0.1 * k, rng)
+                    for k, q in enumerate(truths.as_quat())]
+
+
+def _tracker_errors(truths, readings):
+    """The rotation from truth to reading in the tracker frame, less the misalignment (n, 3)."""
+    measured = Rotation.from_quat([r.q for r in readings])
+    in_tracker = MOUNT.inv() * truths.inv() * measured * MOUNT
+    return (Rotation.from_rotvec(MISALIGNMENT).inv() * in_tracker).as_rotvec()
+
+
+def _tracker_errors_fail(errors, alpha):
+    """
+    Say whether the errors fail their noise model at a false-failure rate alpha (six checks).
+
+    Per tracker axis: the mean inside the two-sided interval of zero for n
+    independent N(0, noise^2) samples, and the variance (about the sample mean)
+    inside the chi-square interval of n - 1 degrees of freedom; alpha / 6 each.
+    """
+    n = len(errors)
+    each = stat_checks.share(6, alpha)
+    low, high = stat_checks.variance_interval(n, each, ddof=1)
+    variance = errors.var(axis=0, ddof=1) / NOISE ** 2
+    return bool(np.any(np.abs(errors.mean(axis=0)) > stat_checks.mean_bound(NOISE, n, each))
+                or np.any((variance < low) | (variance > high)))
+
+
 def test_star_tracker_errors_match_its_parameters_in_the_tracker_frame():
     """
     Check 10 000 star tracker readings against their noise model.
 
     The rotation from the truth to the reading, in the tracker frame, minus the
-    misalignment: its mean inside the 99 % interval of zero and its variance per
-    axis inside the 99 % chi-square interval of noise^2; the covariance the
-    reading reports equals the noise turned into the world frame.
+    misalignment: per axis its mean and its variance inside their intervals,
+    the six checks together failing a correct tracker with probability 1e-4
+    (stat_checks); the covariance the reading reports equals the noise turned
+    into the world frame.
     """
-    noise = np.array([2e-5, 3e-5, 1.5e-4])
-    mount = Rotation.from_euler('xyz', [0.3, -1.1, 0.7])
-    misalignment = np.array([1e-4, -2e-4, 5e-4])
-    tracker = StarTracker(10.0, noise, mount.as_quat(), misalignment)
-    rng = np.random.default_rng(5)
-    truths = Rotation.random(10_000, random_state=7)
-    errors, covs = [], []
-    for k, truth in enumerate(truths):
-        reading = tracker.sample(_truth(truth.as_quat()), 0.1 * k, rng)
+    truths, readings = _tracker_readings(5, 10_000)
+    errors = _tracker_errors(truths, readings)
+    assert not _tracker_errors_fail(errors, stat_checks.FALSE_FAILURE), \
+        (errors.mean(axis=0), errors.var(axis=0) / NOISE ** 2)
+    for truth, reading in zip(truths[:50], readings[:50]):
         measured = Rotation.from_quat(reading.q)
-        in_tracker = mount.inv() * truth.inv() * measured * mount
-        turn = Rotation.from_rotvec(misalignment).inv() * in_tracker
-        errors.append(turn.as_rotvec())
-        if k < 50:
-            expected = (measured * mount).as_matrix() @ np.diag(noise ** 2) @ \
-                (measured * mount).as_matrix().T
-            covs.append(np.abs(np.reshape(reading.covariance, (3, 3)) - expected).max())
-    errors = np.array(errors)
-    n = len(errors)
-    z = stats.norm.ppf(0.995)
-    assert np.all(np.abs(errors.mean(axis=0)) < z * noise / math.sqrt(n)), errors.mean(axis=0)
-    variance = errors.var(axis=0, ddof=1)
-    low, high = (stats.chi2.ppf(p, n - 1) / (n - 1) for p in (0.005, 0.995))
-    assert np.all((low * noise ** 2 < variance) & (variance < high * noise ** 2)), \
-        variance / noise ** 2
-    assert max(covs) < 1e-22
+        expected = (measured * MOUNT).as_matrix() @ np.diag(NOISE ** 2) @ \
+            (measured * MOUNT).as_matrix().T
+        assert np.abs(np.reshape(reading.covariance, (3, 3)) - expected).max() < 1e-22
+    # a tracker 3 % noisier than it says fails the same check
+    assert _tracker_errors_fail(errors * 1.03, stat_checks.FALSE_FAILURE)
+
+
+def test_the_star_tracker_check_fails_a_correct_tracker_at_its_stated_rate():
+    """
+    Run the star tracker's check at a nominal 5 % over 400 seeds of 250 readings each.
+
+    A correct tracker fails the six checks together in at most 5 % of seeds
+    (Bonferroni; 4.9 % for independent checks): the count of failures must be
+    inside the binomial interval of rates 3.5 to 5 % at a false-failure rate of
+    1e-4, so that the check's thresholds, not the seed, are what the
+    10 000-reading test passes by.
+    """
+    failed = sum(_tracker_errors_fail(_tracker_errors(*_tracker_readings(seed, 250)), 0.05)
+                 for seed in range(400))
+    low, high = stat_checks.binomial_count_interval(400, 0.035, 0.05)
+    assert low <= failed <= high, (failed, low, high)
 
 
 def test_star_tracker_exclusions_by_the_sun_and_the_earth():
@@ -148,35 +187,56 @@ def test_star_tracker_exclusions_by_the_sun_and_the_earth():
                           str)
 
 
+SUN_NOISE = 1e-3
+
+
+def _sun_angles2(seed, n):
+    """Return the squared pointing errors (rad^2) of a sun sensor's readings in its field of view."""
+    sensor = SunSensor(10.0, SUN_NOISE, boresight=(1.0, 0.0, 0.0), fov=math.radians(60.0))
+    rng = np.random.default_rng(seed)
+    truths = Rotation.from_euler('xyz', np.random.default_rng(seed + 1).uniform(-0.5, 0.5, (n, 3)))
+    readings = [sensor.sample(_truth(q), 0.0, rng) for q in truths.as_quat()]
+    seen = [k for k, r in enumerate(readings) if not isinstance(r, str)]
+    measured = np.array([readings[k].direction for k in seen])
+    true = truths[seen].inv().apply((1.0, 0.0, 0.0))
+    assert np.allclose(np.linalg.norm(measured, axis=1), 1.0, rtol=0, atol=1e-15)
+    return np.arctan2(np.linalg.norm(np.cross(measured, true), axis=1),
+                      np.sum(measured * true, axis=1)) ** 2
+
+
+def _sun_angles_fail(angles2, alpha):
+    """Say whether the mean squared error leaves 2 noise^2's chi-square(2 n) interval (alpha)."""
+    low, high = stat_checks.variance_interval(len(angles2), alpha, dof_per_sample=2)
+    return not low < np.mean(angles2) / (2.0 * SUN_NOISE ** 2) < high
+
+
 def test_sun_sensor_errors_field_of_view_and_eclipse():
     """
     Check the sun sensor: E[angle^2] = 2 noise^2, its field of view and the eclipse.
 
-    10 000 readings: the mean squared pointing error inside its 99 % interval (a
-    chi-square with 2 degrees of freedom per reading, scaled by noise^2).
+    10 000 readings: the mean squared pointing error inside its interval (a
+    chi-square with 2 degrees of freedom per reading, scaled by noise^2) at a
+    false-failure rate of 1e-4; a sensor 3 % noisier fails it.
     """
-    noise = 1e-3
-    sensor = SunSensor(10.0, noise, boresight=(1.0, 0.0, 0.0), fov=math.radians(60.0))
-    rng = np.random.default_rng(2)
-    truths = Rotation.from_euler('xyz', np.random.default_rng(3).uniform(-0.5, 0.5, (10_000, 3)))
-    angles2 = []
-    for truth in truths:
-        reading = sensor.sample(_truth(truth.as_quat()), 0.0, rng)
-        if isinstance(reading, str):
-            continue
-        true = truth.inv().apply((1.0, 0.0, 0.0))
-        angles2.append(np.arctan2(np.linalg.norm(np.cross(reading.direction, true)),
-                                  np.dot(reading.direction, true)) ** 2)
-        assert np.linalg.norm(reading.direction) == pytest.approx(1.0, abs=1e-15)
-    n = len(angles2)
-    assert n > 9000
-    low, high = (stats.chi2.ppf(p, 2 * n) / n for p in (0.005, 0.995))
-    assert low * noise ** 2 < np.mean(angles2) < high * noise ** 2, np.mean(angles2) / noise ** 2
+    angles2 = _sun_angles2(2, 10_000)
+    assert len(angles2) > 9000
+    assert not _sun_angles_fail(angles2, stat_checks.FALSE_FAILURE), \
+        np.mean(angles2) / SUN_NOISE ** 2
+    assert _sun_angles_fail(angles2 * 1.03 ** 2, stat_checks.FALSE_FAILURE)
+    sensor = SunSensor(10.0, SUN_NOISE, boresight=(1.0, 0.0, 0.0), fov=math.radians(60.0))
+    rng = np.random.default_rng(0)
     away = Rotation.from_euler('z', 61.0, degrees=True).as_quat()
     assert sensor.sample(_truth(away), 0.0, rng) == 'fov'
     a = R_EARTH + 500e3
     assert sensor.sample(_truth((0, 0, 0, 1), (-a, 0.0, 0.0)), 0.0, rng) == 'eclipse'
     assert sensor.sample(_truth((0, 0, 0, 1), (a, 0.0, 0.0)), 0.0, rng) != 'eclipse'
+
+
+def test_the_sun_sensor_check_fails_a_correct_sensor_at_its_stated_rate():
+    """The sun sensor's check at a nominal 5 % over 400 seeds of 250 readings: 4 to 6 % fail."""
+    failed = sum(_sun_angles_fail(_sun_angles2(seed, 250), 0.05) for seed in range(400))
+    low, high = stat_checks.binomial_count_interval(400, 0.04, 0.06)
+    assert low <= failed <= high, (failed, low, high)
 
 
 def test_sensor_parameters_are_refused_naming_them():

@@ -155,10 +155,10 @@ class EstimationFindings:
     its angle; ``inside_3_sigma`` the fraction of samples whose error is inside the
     3-sigma ellipsoid of the reported covariance; ``nees`` the mean normalised
     estimation error squared (3 for a consistent estimator); ``correlation`` the
-    integrated autocorrelation time (samples) of the whitened errors, and
+    integrated autocorrelation time (samples) of the NEES, and
     ``independent`` = samples / correlation, the independent samples the bounds
-    count; ``bounds`` the two-sided 95 % chi-square interval of the mean NEES for
-    3 ``independent`` degrees of freedom; ``verdict`` 'consistent', 'overconfident'
+    count; ``bounds`` the two-sided chi-square interval of confidence ``level``
+    (0.95 unless asked) of the mean NEES for 3 ``independent`` degrees of freedom; ``verdict`` 'consistent', 'overconfident'
     (NEES above the interval), 'pessimistic' (below) or 'unavailable'. With a
     bias estimate and the true bias: ``bias_rms`` (3,) rad/s.
     """
@@ -177,6 +177,7 @@ class EstimationFindings:
     independent: float = math.nan
     bounds: tuple = (math.nan, math.nan)
     bias_rms: object = None
+    level: float = 0.95
 
 
 @dataclass(frozen=True)

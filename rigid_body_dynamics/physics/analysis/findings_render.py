@@ -97,10 +97,12 @@ OTHER_KEYS = (
     ('fraction inside 3 sigma', "the share of errors inside the covariance's 99.73 % "
      'ellipsoid'),
     ('mean NEES', 'e^T P^-1 e averaged over the window (3 when consistent)'),
-    ('NEES 95 % interval', 'the chi-square interval of the mean NEES for the independent '
+    ('NEES interval', 'the chi-square interval of the mean NEES for the independent '
      'samples'),
-    ('correlation time (samples)', 'the integrated autocorrelation time of the whitened '
-     'errors'),
+    ('NEES interval confidence', 'its confidence (`estimation_confidence`): the share of runs '
+     'of a consistent estimator it holds'),
+    ('correlation time (samples)', "the integrated autocorrelation time of the NEES (Geyer's "
+     'initial monotone sequence)'),
     ('independent samples', 'estimates matched / correlation time: what the interval counts'),
     ('gyro bias error RMS per body axis (rad/s)', 'the bias estimate against the true bias, '
      "when both are published at the estimates' stamps"),
@@ -298,7 +300,8 @@ def estimation_key_values(e):
                    ('attitude error max per world axis (rad)',
                     [float(c) for c in e.largest]),
                    ('fraction inside 3 sigma', e.inside_3_sigma), ('mean NEES', e.nees),
-                   ('NEES 95 % interval', list(e.bounds)),
+                   ('NEES interval', list(e.bounds)),
+                   ('NEES interval confidence', e.level),
                    ('correlation time (samples)', e.correlation),
                    ('independent samples', e.independent)]
         if e.bias_rms is not None:
