@@ -29,7 +29,12 @@ ELEMENTS = (7.5e6, 0.1, 1.0, 0.5, 0.3, 0.2)       # a 1.8 h orbit, perigee 373 k
 
 
 def test_kepler_orbit_against_the_two_body_ode_over_ten_orbits():
-    """Position within 1e-9 of |r| of a DOP853 of r'' = -mu r / |r|^3 over ten orbits."""
+    """
+    Position within 3e-11 of |r| of a DOP853 of r'' = -mu r / |r|^3 over ten orbits.
+
+    Delivered 9e-12 (the reference's own error at rtol 1e-13); after ten whole periods the
+    orbit is back within 3e-14 of its radius (delivered 6e-15).
+    """
     orbit = KeplerOrbit(ELEMENTS)
     r0, v0 = orbit.state(0.0)
     times = np.linspace(0.0, 10 * orbit.period, 41)
@@ -38,9 +43,9 @@ def test_kepler_orbit_against_the_two_body_ode_over_ten_orbits():
                     rtol=1e-13, atol=1e-7)
     worst = max(np.linalg.norm(np.subtract(orbit.position(t), sol.y[:3, k])) / np.linalg.norm(
         sol.y[:3, k]) for k, t in enumerate(times))
-    assert worst < 1e-9
+    assert worst < 3e-11, worst
     # after a whole number of periods the orbit is back, to round-off
-    np.testing.assert_allclose(orbit.state(10 * orbit.period)[0], r0, rtol=0, atol=1e-8 * 7.5e6)
+    np.testing.assert_allclose(orbit.state(10 * orbit.period)[0], r0, rtol=0, atol=3e-14 * 7.5e6)
 
 
 def test_kepler_orbit_keeps_the_conic_and_its_invariants_at_any_time(rng):
@@ -255,6 +260,12 @@ def test_a_model_without_stage_statements_is_called_at_every_stage():
 
 
 MOMENTS = (2.0, 3.0, 1.0)
+#: The references' constants, written here from their sources, not read from the package:
+#: IGRF-13's 2020 dipole g10, g11, h11 (nT) and reference radius 6371.2 km (Alken et al.,
+#: Earth, Planets and Space 73, 2021), the Earth's rotation rate (IERS, rad/s), the field's
+#: angle at t = 0 the runs give DipoleField (0.4 rad), and the Earth's GM (IERS 2010, m^3/s^2).
+REFERENCE_FIELD = (-29404.8, -1450.9, 4652.5, 6371.2e3, 7.2921150e-5, 0.4)
+EARTH_MU = 3.986004418e14
 BOX = (0.05, 0.02, 0.03)    # magnetorquer limits (A m^2 per body axis) of the whole-model run
 
 
@@ -285,19 +296,21 @@ def _whole_model_run(dt, seconds):
     def clipped(k, _q, _w):
         return tuple(max(-b, min(b, c)) for c, b in zip(_dipole_schedule(k), BOX))
     r0, v0 = orbit.state(0.0)
-    ref = space_zoh_reference(MOMENTS, MU_EARTH, r0, v0, q0, w0, 0.1, holds, clipped,
-                              field=field, residual=residual)
+    ref = space_zoh_reference(MOMENTS, EARTH_MU, r0, v0, q0, w0, 0.1, holds, clipped,
+                              field=REFERENCE_FIELD, residual=residual)
     return body, outbox, ref
 
 
-@pytest.mark.parametrize('dt, seconds', [(0.001, 5.0), (0.01, 50.0)])
-def test_the_whole_model_through_the_engine_against_an_independent_dop853(dt, seconds):
+@pytest.mark.parametrize('dt, seconds, tol', [(0.001, 5.0, 1e-13), (0.01, 50.0, 5e-13)])
+def test_the_whole_model_through_the_engine_against_an_independent_dop853(dt, seconds, tol):
     """
     Orbit, gravity gradient, dipole field, residual dipole and held magnetorquer commands.
 
     A tumbling body (|omega| 1.4 rad/s) for 500 commands of 0.1 s: attitude and omega at
-    every 0.1 s within 1e-12 (rad, and relative) of DOP853 at rtol 2.5e-14, the position
-    within 1e-14 relative (the reference integrates the orbit as an ODE).
+    every 0.1 s within ``tol`` (rad, and relative) of DOP853 at rtol 2.5e-14, the position
+    within 1e-14 relative (the reference integrates the orbit as an ODE). Delivered at 1 ms
+    steps 2.6e-14 rad and 3.0e-14 relative, at 10 ms 1.9e-13 and 4.7e-14; the position
+    7e-16 and 2.4e-15.
     """
     body, outbox, (q_ref, w_ref, r_ref) = _whole_model_run(dt, seconds)
     states = outbox
@@ -308,7 +321,7 @@ def test_the_whole_model_through_the_engine_against_an_independent_dop853(dt, se
                   for s, w in zip(states, w_ref[1:]))
     worst_r = max(np.linalg.norm(np.subtract(s.position[0], r)) / np.linalg.norm(r)
                   for s, r in zip(states, r_ref[1:]))
-    assert worst_q < 1e-12 and worst_w < 1e-12 and worst_r < 1e-14, (worst_q, worst_w, worst_r)
+    assert worst_q < tol and worst_w < tol and worst_r < 1e-14, (worst_q, worst_w, worst_r)
     # the magnetic torque is not negligible: omega moved by far more than the tolerance
     assert np.linalg.norm(np.subtract(w_ref[-1], w_ref[0])) > 1e-6
     # the commands over the limits were clipped per axis and counted, the dipole applied
@@ -344,16 +357,19 @@ def test_pitch_libration_frequency_is_n_sqrt_3_ix_minus_iz_over_iy():
 
     The pitch angle oscillates at omega_p = n sqrt(3 (Ix - Iz) / Iy) (Wie, section 6.3);
     the amplitude correction at 0.01 rad is about theta0^2 / 4 = 2.5e-5, so the measured
-    period is within 1e-4 of the small-angle one.
+    period is within 1e-4 of the small-angle one. Moments (2, 3, 0.5) (the Lagrange region)
+    put omega_p at 1.22 n, away from the orbit rate, so that no motion at the orbit's own
+    period passes for the libration (at (2, 3, 1) omega_p would be n itself).
     """
+    moments = (2.0, 3.0, 0.5)
     orbit = KeplerOrbit(circular_elements(500e3))
     n = orbit.n
-    env = SpaceEnvironment(orbit, None, [GravityGradient(MOMENTS, MU_EARTH)])
+    env = SpaceEnvironment(orbit, None, [GravityGradient(moments, MU_EARTH)])
     r, v = orbit.state(0.0)
     lvlh = Rotation.from_quat(lvlh_quaternion(r, v))
     start = lvlh * Rotation.from_rotvec([0.0, 0.01, 0.0])
-    body = make_integrator('exact', MOMENTS, 1.0, start.as_quat(), (0.0, -n, 0.0))
-    omega_p = n * math.sqrt(3.0 * (MOMENTS[0] - MOMENTS[2]) / MOMENTS[1])
+    body = make_integrator('exact', moments, 1.0, start.as_quat(), (0.0, -n, 0.0))
+    omega_p = n * math.sqrt(3.0 * (moments[0] - moments[2]) / moments[1])
     steps = int(3.2 * 2 * math.pi / omega_p)
     t, pitch = np.empty(steps + 1), np.empty(steps + 1)
     for k in range(steps + 1):
@@ -449,7 +465,7 @@ def test_a_body_with_reaction_wheels_in_orbit_against_an_independent_dop853():
     worst = [0.0, 0.0, 0.0]
     for k, snap in enumerate(outbox):
         dipole = tuple(max(-b, min(b, c)) for c, b in zip(_dipole_schedule(k), BOX))
-        env = space_rhs(MOMENTS, MU_EARTH, field, True, dipole)
+        env = space_rhs(MOMENTS, EARTH_MU, REFERENCE_FIELD, True, dipole)
 
         def rhs(t, s, env=env):
             orbit_part = env(t, np.concatenate([s[:7], s[15:21]]))

@@ -158,6 +158,10 @@ PARAMETERS = ParameterTable([
           'and the small-angle theory above which the orbit status is WARN (100x: ERROR); '
           'finite amplitudes differ by about the squared angle.', low=0.0, high=1.0,
           above_low=True),
+    Param('estimation_confidence', 'double', 0.95, '0.95',
+          "Confidence of the mean NEES interval of the estimation status: a consistent "
+          "estimator is called overconfident or pessimistic in a share 1 - this of windows "
+          "(0.9999 for a test that must not fail by chance).", low=0.5, high=1.0 - 1e-9),
 ], cross_checks=(_wheels,))
 
 
@@ -520,7 +524,7 @@ class AttitudeAnalyzer(Node):
             statuses += diagnostics.statuses(found, name, hw, origin)
         if self._estimates:
             statuses.append(diagnostics.estimation_status(
-                estimation(*buf.estimate_arrays()), name, hw))
+                estimation(*buf.estimate_arrays(), level=s['estimation_confidence']), name, hw))
         array = DiagnosticArray(status=statuses)
         array.header.stamp = self.get_clock().now().to_msg()
         self._pub_diag.publish(array)

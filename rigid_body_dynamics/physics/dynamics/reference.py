@@ -120,18 +120,19 @@ def space_rhs(moments, mu, field=None, gravity_gradient=True, dipole=(0.0, 0.0, 
     sums scalar torque models): the orbit is integrated here as the two-body ODE
     r'' = -mu r / |r|^3, the field is d = (g11, h11, g10) turned by scipy's
     Rotation, and the torques are numpy cross products. ``moments`` principal (kg
-    m^2), ``mu`` (m^3/s^2), ``field`` a
-    :class:`~.environment.DipoleField` (its coefficients, rotation and radius
-    are read; None = no field), ``gravity_gradient`` on or off, ``dipole`` the
+    m^2), ``mu`` (m^3/s^2), ``field`` six numbers (g10, g11, h11 (nT), the
+    reference radius (m), the planet's rotation rate (rad/s), its angle at t = 0
+    (rad)), given by the caller, not read from the model under test (None = no
+    field), ``gravity_gradient`` on or off, ``dipole`` the
     body's total dipole (A m^2, principal frame) held.
     """
     from scipy.spatial.transform import Rotation
     inertia = np.diag(np.asarray(moments, dtype=float))
     m = np.asarray(dipole, dtype=float)
     if field is not None:
-        g10, g11, h11 = field.coefficients
+        g10, g11, h11, radius, rate, theta0 = (float(c) for c in field)
         d_fixed = np.array([g11, h11, g10]) * 1e-9
-        r_ref3 = field._r3
+        r_ref3 = radius ** 3
 
     def rhs(t, y):
         w, q, r, v = y[:3], y[3:7], y[7:10], y[10:13]
@@ -142,7 +143,7 @@ def space_rhs(moments, mu, field=None, gravity_gradient=True, dipole=(0.0, 0.0, 
         if gravity_gradient:
             tau += 3.0 * mu / rn ** 5 * np.cross(r_b, inertia @ r_b)
         if field is not None:
-            d = Rotation.from_euler('z', field.theta0 + field.rate * t).apply(d_fixed)
+            d = Rotation.from_euler('z', theta0 + rate * t).apply(d_fixed)
             rhat = r / rn
             b_w = r_ref3 / rn ** 3 * (3.0 * (d @ rhat) * rhat - d)
             tau += np.cross(m, body_from_world.apply(b_w))
