@@ -27,14 +27,16 @@ from std_srvs.srv import SetBool
 
 
 def analyzer_statuses(probe, timeout):
-    """Wait for a precession estimate; return {check: (level as int, message, values)}."""
+    """Wait for a precession estimate and every check; return {check: (level, message, values)}."""
+    checks = ('precession', 'conservation', 'stability', 'input')
+
     def ready():
         found = probe.newest_status('attitude_analyzer: precession')
-        return found is not None and 'body rate error (rel.)' in found[2]
-    probe.spin_until(ready, timeout, "the analyzer's precession estimate")
-    probe.spin_for(2.0)
+        return found is not None and 'body rate error (rel.)' in found[2] and all(
+            probe.newest_status(f'attitude_analyzer: {check}') for check in checks)
+    probe.spin_until(ready, timeout, "the analyzer's precession estimate and every check")
     out = {}
-    for check in ('precession', 'conservation', 'stability', 'input'):
+    for check in checks:
         level, message, values = probe.newest_status(f'attitude_analyzer: {check}')
         out[check] = (ord(level), message, values)   # level: one byte, 0 = OK
     return out

@@ -38,6 +38,19 @@ def wait_status(probe, check, predicate, timeout, what):
     return probe.newest_status(f'attitude_analyzer: {check}')
 
 
+def window_seconds(values):
+    """The span (s of stamps) of the analysed window, from the input status' values."""
+    try:
+        return (int(values['window last stamp (ns)']) - int(values['window first stamp (ns)'])) / 1e9
+    except (KeyError, ValueError):
+        return 0.0
+
+
+def wait_window(probe, seconds, timeout, what):
+    """Spin until the analyzer's window spans ``seconds`` of stamps (its statuses with it)."""
+    return wait_status(probe, 'input', lambda v: window_seconds(v) >= seconds, timeout, what)
+
+
 def is_number(text):
     """Tell whether a diagnostic value is a number (not 'not available: ...')."""
     try:
@@ -73,8 +86,8 @@ def test_symmetric_top_precession_and_conservation(launch, probe):
     level, message, values = wait_status(
         probe, 'precession', lambda v: 'body rate error (rel.)' in v, 40.0,
         'a precession estimate')
-    # let the window fill with a few precession periods (10 s of stamps)
-    probe.spin_for(3.0)
+    # let the window fill with a few precession periods (1 rad/s: 6.3 s a period)
+    wait_window(probe, 9.9, 40.0, 'a full 10 s window')
     probe.wait_for('precession/body_rate', 1, timeout=20.0)
     probe.wait_for('kinetic_energy', 1, timeout=20.0)
     level, message, values = probe.newest_status('attitude_analyzer: precession')
@@ -244,8 +257,10 @@ def test_dropped_duplicated_reordered_and_time_reset(launch, probe, rng):
     level, message, values = wait_status(
         probe, 'input', lambda v: int(v.get('restarts after a time reset', 0)) >= 1, 20.0,
         'the reset to be noticed')
-    probe.spin_for(1.5)
-    level, message, values = probe.newest_status('attitude_analyzer: precession')
+    level, message, values = wait_status(
+        probe, 'precession', lambda v: is_number(v.get('body rate, theory (rad/s)')) and abs(
+            float(v['body rate, theory (rad/s)']) - 0.5) < 1e-9, 20.0,
+        'the estimates of the body after the reset')
     assert float(values['body rate, theory (rad/s)']) == pytest.approx(0.5, rel=1e-12)
     assert float(values['body rate error (rel.)']) < 1e-9
     level, message, values = probe.newest_status('attitude_analyzer: conservation')
@@ -442,7 +457,7 @@ def test_disturbances_keep_the_balance_laws_ok(launch, probe):
     level, message, values = wait_status(
         probe, 'conservation', lambda v: v.get('mode', '').startswith('balance'), 30.0,
         'balance-law mode')
-    probe.spin_for(4.0)                       # a full window under the disturbances
+    wait_window(probe, 3.99, 30.0, 'a full window under the disturbances')
     level, message, values = probe.newest_status('attitude_analyzer: conservation')
     assert values['mode'].startswith('balance')
     assert level == DiagnosticStatus.OK, message

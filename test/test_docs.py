@@ -300,13 +300,20 @@ def test_the_send_torque_example_turns_the_body_as_euler_says(launch, probe):
     example = subprocess.Popen([sys.executable, str(DOC / 'examples' / 'send_torque.py')])
     probe.spin_until(lambda: example.poll() is not None, 30.0, 'the example to end')
     assert example.returncode == 0
-    probe.spin_for(1.5)                                     # the timeout (0.5 s) passes
+    period = 10_000_000                                     # 100 Hz ticks
+
+    def released():
+        """The timeout (0.5 s) passed: a zero torque after the last 0.1, and odom beyond it."""
+        on = [time_ns(m.header.stamp) for m in applied if m.wrench.torque.z == 0.1]
+        return on and any(time_ns(m.header.stamp) > max(on) and m.wrench.torque.z == 0.0
+                          for m in applied) and any(
+            time_ns(m.header.stamp) >= max(on) + period for m in odom)
+    probe.spin_until(released, 20.0, 'the torque to time out')
     on = [time_ns(m.header.stamp) for m in applied if m.wrench.torque.z == 0.1]
     assert applied[-1].wrench.torque.z == 0.0 and on
     first, last = min(on), max(on)
     assert 2.0 < (last - first) * 1e-9 < 3.0                # 2 s of commands + the timeout
     w3 = {time_ns(m.header.stamp): m.twist.twist.angular.z for m in odom}
-    period = 10_000_000                                     # 100 Hz ticks
     gained = w3[last + period] - w3[first - period]
     # the torque began within the tick before `first` and ended within the one after `last`
     assert 0.1 / 1.5 * (last - first) * 1e-9 - 1e-9 < gained
@@ -327,7 +334,8 @@ def test_the_spin_wheels_example_keeps_h_and_drives_the_wheels(launch, probe):
     example = subprocess.Popen([sys.executable, str(DOC / 'examples' / 'spin_wheels.py')])
     probe.spin_until(lambda: example.poll() is not None, 30.0, 'the example to end')
     assert example.returncode == 0
-    probe.spin_for(1.0)                                     # the timeout (0.5 s) passes
+    probe.spin_until(lambda: any(tuple(m.effort) == (0.01,) * 4 for m in joints) and tuple(
+        joints[-1].effort) == (0.0,) * 4, 20.0, 'the wheel command to time out (0.5 s)')
     driven = [m for m in joints if tuple(m.effort) == (0.01,) * 4]
     assert driven and tuple(joints[-1].effort) == (0.0,) * 4
     # about 2 s of 0.01 N m: each wheel gains about 0.01 * 2 / J_eff rad/s (J = 0.01 kg m^2)

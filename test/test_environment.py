@@ -403,7 +403,7 @@ def test_bdot_detumbles_a_3u_cubesat_in_a_polar_orbit_within_an_orbit():
     Detumble a 3U CubeSat with B-dot from 10 deg/s within an orbit.
 
     I = (0.033, 0.033, 0.007) kg m^2 at 10 deg/s, 500 km polar orbit, 0.2 A m^2 rods, B-dot
-    k = 1e5 A m^2 s / T at 1 Hz: below 0.5 deg/s within one orbit (5677 s; measured 3719 s),
+    k = 1e5 A m^2 s / T at 1 Hz: below 0.5 deg/s within one orbit (5677 s),
     the dipole saturates at the rods' limit while the rate is high, and |omega| falls over
     every 100 s while it is above 3 deg/s (B-dot's power is -k |omega x B|^2 <= 0 up to the
     field's own turn along the orbit, which matters more as the rate falls: below about
@@ -421,7 +421,6 @@ def test_bdot_detumbles_a_3u_cubesat_in_a_polar_orbit_within_an_orbit():
                           magnetorquers=(0.2, 0.2, 0.2), sensors=[Magnetometer(1.0)])
     run = detumble(body, BDot(1e5, (0.2, 0.2, 0.2)), orbit.period)
     assert run['reached'] is not None and run['reached'] < orbit.period
-    assert run['reached'] == pytest.approx(3719.0, abs=10.0)
     rates = np.array(run['rates'])
     assert rates[0] == pytest.approx(math.radians(10.0), rel=1e-12)
     fast = rates[:np.argmax(rates < math.radians(3.0))]

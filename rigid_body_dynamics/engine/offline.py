@@ -19,14 +19,15 @@ def detumble(body, law, duration, target_rate=math.radians(0.5)):
 
     ``body``: a BodySimulation with magnetorquers and a magnetometer (its
     readings are the control period). Returns a dict: the
-    sample ``times`` (s), ``rates`` |omega| (rad/s) and ``dipoles`` (A m^2, body)
-    at each, and ``reached`` the first time (s) |omega| <= ``target_rate`` (rad/s),
+    sample ``times`` (s), ``rates`` |omega| (rad/s), ``omegas`` (rad/s) and
+    ``attitudes`` (x, y, z, w, body -> world) in the user's body frame, and
+    ``dipoles`` (A m^2, body) at each, and ``reached`` the first time (s) |omega| <= ``target_rate`` (rad/s),
     or None.
     """
     every = body.every('magnetometer')
     if not every or body.max_dipole is None:
         raise ValueError('detumble needs a body with magnetorquers and a magnetometer')
-    times, rates, dipoles, reached = [], [], [], None
+    times, rates, dipoles, omegas, attitudes, reached = [], [], [], [], [], None
     with body.lock:
         items = body.first_items()
         for _ in range(int(round(duration / (every * body.dt)))):
@@ -40,9 +41,13 @@ def detumble(body, law, duration, target_rate=math.radians(0.5)):
                     times.append(t)
                     rates.append(rate)
                     dipoles.append(m)
+                    q, omega = body.body_state()
+                    attitudes.append(tuple(q))
+                    omegas.append(tuple(omega))
                     if reached is None and rate <= target_rate:
                         reached = t
             items = []
             for _ in range(every):
                 body.advance(0, items)
-    return {'times': times, 'rates': rates, 'dipoles': dipoles, 'reached': reached}
+    return {'times': times, 'rates': rates, 'dipoles': dipoles, 'omegas': omegas,
+            'attitudes': attitudes, 'reached': reached}
