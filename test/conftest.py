@@ -80,9 +80,11 @@ def launch(tmp_path, request):
     """
     Start node processes: call the fixture with a module, ros args, a name (and env additions).
 
-    Every process still running at the end of the test is stopped with SIGINT. When the
-    test failed, the end of each node's output is printed (the report's teardown output),
-    since the temporary folder holding it is not kept.
+    Every process still running at the end of the test is stopped with SIGINT. A process
+    the test neither stopped nor waited for must then have exited 0 with no traceback in
+    its output (a node that crashed, or did not end cleanly on SIGINT, fails the test that
+    passed). When the test failed, the end of each node's output is printed (the report's
+    teardown output), since the temporary folder holding it is not kept.
     """
     from ros_harness import NodeProcess
     started = []
@@ -92,14 +94,21 @@ def launch(tmp_path, request):
         started.append(proc)
         return proc
     yield start
+    unclean = []
     for proc in started:
-        if proc.proc.poll() is None:
-            proc.stop()
+        if proc.handled:
+            continue
+        code = proc.stop()[0] if proc.proc.poll() is None else proc.proc.returncode
+        if code != 0 or 'Traceback' in proc.output():
+            unclean.append(f'{proc.log_path}: exit code {code}')
     report = getattr(request.node, 'report_call', None)
-    if report is not None and report.failed:
+    failed = report is not None and report.failed
+    if failed or unclean:
         for proc in started:
             lines = proc.output().splitlines()[-LOG_TAIL:]
             print(f'--- {proc.log_path} (last {len(lines)} lines) ---', *lines, sep='\n')
+    if unclean and not failed:
+        pytest.fail('a node did not end cleanly (exit 0, no traceback): ' + '; '.join(unclean))
 
 
 @pytest.fixture(scope='session')

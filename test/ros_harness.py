@@ -134,6 +134,7 @@ class NodeProcess:
     """A node started as its own process; ``stop()`` sends SIGINT and returns the exit code."""
 
     def __init__(self, module, ros_args=(), log_dir=None, name='node', env=None):
+        self.handled = False            # the test stopped it or waited for it (stop, wait)
         self.log_path = os.path.join(log_dir or os.environ['ROS_LOG_DIR'], f'{name}.log')
         self._log = open(self.log_path, 'w')
         self.proc = start_node(module, ros_args, stdout=self._log, stderr=subprocess.STDOUT,
@@ -148,6 +149,7 @@ class NodeProcess:
 
     def stop(self, timeout=10.0):
         """SIGINT, then wait; kill after ``timeout`` s. Returns (exit code, seconds taken)."""
+        self.handled = True
         start = time.monotonic()
         code = interrupt(self.proc, timeout)
         self._log.close()
@@ -155,6 +157,7 @@ class NodeProcess:
 
     def wait(self, timeout):
         """Wait for the process to end by itself; returns its exit code."""
+        self.handled = True
         code = self.proc.wait(timeout)
         self._log.close()
         return code

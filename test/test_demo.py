@@ -22,10 +22,12 @@ def test_demo_runs_both_nodes_and_prints_the_analyzers_findings():
     assert 'exit codes 0, 0' in out.stdout
     # Start-up is no missed deadline (on a fake clock: test_engine's
     # test_the_schedule_starts_when_its_thread_does_not_at_construction). Here the only
-    # warning allowed is the one a loaded machine earns: a stall of the simulator, said.
-    warnings = [line for line in (out.stdout + out.stderr).splitlines()
-                if 'WARN' in line and 'cannot keep up with real_time_factor' not in line]
-    assert not warnings, warnings
+    # warning allowed is the one a loaded machine earns, once: a stall of the simulator,
+    # said (seen once beside a CPU hog); a second would be a simulator that keeps falling
+    # behind, which is a defect.
+    lines = [line for line in (out.stdout + out.stderr).splitlines() if 'WARN' in line]
+    stalls = [line for line in lines if 'cannot keep up with real_time_factor' in line]
+    assert len(stalls) <= 1 and len(lines) == len(stalls), lines
     errors = _relative_errors(out.stdout)
     assert len(errors) == 2 and max(errors) < 1e-9
     assert 'conservation: conserved' in out.stdout
@@ -111,3 +113,34 @@ def test_the_manuals_satellite_yaml_is_the_demos_scene():
     assert config['/**']['ros__parameters'] == shared
     assert config['/**/attitude_simulator']['ros__parameters'] == sim
     assert config['/**/attitude_controller']['ros__parameters'] == ctl
+
+
+def test_the_manuals_libration_yaml_is_the_demos_scene():
+    """doc/examples/libration.yaml: the scene's values, the initial rate (0, -n, 0) + offset."""
+    import math
+    import os
+    import yaml
+    from rigid_body_dynamics.tools.libration_scene import LIBRATION_SCENE, parameters
+    path = os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples', 'libration.yaml')
+    with open(path) as f:
+        config = yaml.safe_load(f)
+    shared, sim, analyzer = parameters()
+    assert config['/**']['ros__parameters'] == shared
+    assert config['/**/attitude_simulator']['ros__parameters'] == sim
+    assert config['/**/attitude_analyzer']['ros__parameters'] == analyzer
+    n = math.sqrt(3.986004418e14 / 6878137.0 ** 3)          # GM (IERS 2010), a = R + 500 km
+    offset = LIBRATION_SCENE['rate_offset']
+    assert sim['initial_angular_velocity'] == [offset[0], -n + offset[1], offset[2]]
+
+
+def test_demo_libration_scene_on_the_nodes_and_offline():
+    """The three libration frequencies within 1e-4 of the theory, the Jacobi drift < 1e-12."""
+    for args in (('--preset', 'libration'), ('--preset', 'libration', '--offline')):
+        out = _demo(*args)
+        assert out.returncode == 0, out.stderr
+        assert '--offline' in args or 'exit codes 0, 0' in out.stdout
+        assert 'stable (Lagrange region)' in out.stdout, out.stdout
+        errors = _relative_errors(out.stdout)
+        assert len(errors) == 3 and max(errors) < 1e-4, out.stdout
+        drift = re.search(r'Jacobi integral drift ([0-9.e+-]+)', out.stdout)
+        assert drift and float(drift.group(1)) < 1e-12, out.stdout

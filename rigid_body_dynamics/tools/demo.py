@@ -12,7 +12,10 @@ rest to a target in lockstep, its settling time against the PD theory and
 the pointing error at the end; then the same body flown by four reaction
 wheels against a disturbance, the wheels spinning up and unloading their
 momentum; then a 3U CubeSat in a polar orbit detumbled by B-dot with
-magnetorquers (``--preset satellite``, the manual's ``satellite.yaml``).
+magnetorquers (``--preset satellite``, the manual's ``satellite.yaml``); and
+a satellite librating about the local vertical under the gravity gradient, its
+frequencies against the small-angle theory (``--preset libration``, the manual's
+``libration.yaml``; not part of the tour).
 ``--offline`` measures the same straight from the physics layer and the engine,
 without ROS.
 """
@@ -29,6 +32,7 @@ from ..physics import FreeRigidBody, INTEGRATORS, presets, quaternions, simulate
 from ..physics.analysis import analyse, Trajectory
 from ..physics.analysis.findings_render import text_lines
 from ..physics.control import QuaternionPD, settling_time
+from .libration_scene import LIBRATION, libration_offline, run_libration
 
 #: The closed-loop scene: 30 degrees about x from rest, wn 2 rad/s, zeta 0.7, 100 Hz, 10 s.
 SLEW = {'target': (math.sin(math.radians(15.0)), 0.0, 0.0, math.cos(math.radians(15.0))),
@@ -509,8 +513,8 @@ def main(argv=None):
     """Console entry point: print theory against simulation (nodes, or --offline)."""
     parser = argparse.ArgumentParser(prog='rigid_body_demo', description=__doc__.splitlines()[1])
     parser.add_argument('--preset', default=None,
-                        help=f'preset name, or {CLOSED_LOOP}, {WHEELS} or {SATELLITE} '
-                        '(default: a tour of all five scenes)')
+                        help=f'preset name, or {CLOSED_LOOP}, {WHEELS}, {SATELLITE} or '
+                        f'{LIBRATION} (default: a tour of the first five scenes)')
     parser.add_argument('--integrator', default='exact', choices=sorted(INTEGRATORS))
     parser.add_argument('--duration', type=float, default=None,
                         help='simulated seconds (--offline)')
@@ -532,6 +536,10 @@ def main(argv=None):
                 continue
             if name == SATELLITE:
                 lines = satellite_offline() if args.offline else run_satellite()
+                print('\n'.join(lines), flush=True)
+                continue
+            if name == LIBRATION:
+                lines = libration_offline() if args.offline else run_libration()
                 print('\n'.join(lines), flush=True)
                 continue
             body = presets.get(name)

@@ -221,11 +221,16 @@ def text_lines(found):
             if section == wanted:
                 out += quantity_lines(_labels(section, field, getattr(found, section))[1], qty)
     out.append(conservation_line(found.conservation))
-    o = found.orbit
-    if o is not None:
-        out.append(f'  orbit: {o.message}')
-        for field, qty in _orbit_quantities(o):
-            out += quantity_lines(_labels('orbit', field, o)[1], qty)
+    if found.orbit is not None:
+        out += orbit_lines(found.orbit)
+    return out
+
+
+def orbit_lines(o):
+    """Readable lines of :class:`~.findings.OrbitFindings`: its message, each frequency."""
+    out = [f'  orbit: {o.message}']
+    for field, qty in _orbit_quantities(o):
+        out += quantity_lines(_labels('orbit', field, o)[1], qty)
     return out
 
 
