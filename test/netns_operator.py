@@ -16,6 +16,7 @@ service.
 
 import argparse
 import json
+import math
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import InertiaStamped
@@ -32,9 +33,11 @@ def analyzer_statuses(probe, timeout):
 
     def ready():
         found = probe.newest_status('attitude_analyzer: precession')
+        rate = (probe.newest_status('attitude_analyzer: input') or (0, '', {}))[2].get('rate (Hz)')
         return found is not None and 'body rate error (rel.)' in found[2] and all(
-            probe.newest_status(f'attitude_analyzer: {check}') for check in checks)
-    probe.spin_until(ready, timeout, "the analyzer's precession estimate and every check")
+            probe.newest_status(f'attitude_analyzer: {check}') for check in checks) and \
+            rate is not None and math.isfinite(float(rate))
+    probe.spin_until(ready, timeout, "the analyzer's precession estimate, input rate and checks")
     out = {}
     for check in checks:
         level, message, values = probe.newest_status(f'attitude_analyzer: {check}')

@@ -155,6 +155,11 @@ class NodeProcess:
         self._log.close()
         return code, time.monotonic() - start
 
+    def kill(self):
+        """SIGKILL the process (a crash the test makes: its exit code is not checked)."""
+        self.handled = True
+        self.proc.kill()
+
     def wait(self, timeout):
         """Wait for the process to end by itself; returns its exit code."""
         self.handled = True

@@ -65,7 +65,7 @@ def correlated_mean_square_interval(x, sigma, alpha):
 
 def binomial_count_interval(trials, p_low, p_high, alpha=FALSE_FAILURE):
     """
-    Return (low, high): the counts of failures over ``trials`` runs a rate in [p_low, p_high] gives.
+    Return (low, high): the failure counts over ``trials`` runs a rate in [p_low, p_high] gives.
 
     A count below ``low`` has probability <= alpha / 2 at the rate p_low, one
     above ``high`` <= alpha / 2 at p_high.

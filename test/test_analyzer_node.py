@@ -39,9 +39,10 @@ def wait_status(probe, check, predicate, timeout, what):
 
 
 def window_seconds(values):
-    """The span (s of stamps) of the analysed window, from the input status' values."""
+    """Return the span (s of stamps) of the analysed window, from the input status' values."""
     try:
-        return (int(values['window last stamp (ns)']) - int(values['window first stamp (ns)'])) / 1e9
+        last, first = (int(values[f'window {end} stamp (ns)']) for end in ('last', 'first'))
+        return (last - first) / 1e9
     except (KeyError, ValueError):
         return 0.0
 
@@ -458,6 +459,8 @@ def test_disturbances_keep_the_balance_laws_ok(launch, probe):
         probe, 'conservation', lambda v: v.get('mode', '').startswith('balance'), 30.0,
         'balance-law mode')
     wait_window(probe, 3.99, 30.0, 'a full window under the disturbances')
+    probe.spin_until(lambda: len(applied) > 20 and len(energy) > 20, 20.0,
+                     'applied_torque and kinetic_energy')
     level, message, values = probe.newest_status('attitude_analyzer: conservation')
     assert values['mode'].startswith('balance')
     assert level == DiagnosticStatus.OK, message

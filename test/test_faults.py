@@ -50,7 +50,7 @@ def test_analyzer_crash_and_simulator_restart(launch, probe, monkeypatch):
         return found is not None and 'body rate error (rel.)' in found[2] and \
             float(found[2]['body rate error (rel.)']) < 1e-6
     probe.spin_until(good_estimate, 40.0, 'estimates')
-    analyzer.proc.kill()                                 # a crash: no clean shutdown
+    analyzer.kill()                                      # a crash: no clean shutdown
     analyzer.proc.wait(5.0)
     probe.messages['/diagnostics'].clear()
     analyzer = launch('rigid_body_dynamics.nodes.analyzer', '-p', 'window:=4.0',

@@ -134,6 +134,62 @@ def test_three_bodies_over_two_processes(launch, probe, tmp_path):
     assert not any(alive(pid) for pid in pids.values())
 
 
+def _proc_cpu(pid):
+    """User + system CPU (s) of process ``pid`` from /proc/<pid>/stat, read here."""
+    with open(f'/proc/{pid}/stat') as f:
+        fields = f.read().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def test_the_fleet_reports_the_cpu_of_its_workers(launch, probe):
+    """
+    Each worker's status has its CPU, the fleet's status the sum, the exit log the run's.
+
+    Two workers of two asymmetric bodies: each worker's CPU time (s) on /diagnostics is what
+    /proc says of that pid, read here a moment later (within 0.3 s of CPU), its cores over
+    the last second between 0.1 % and a whole core, the fleet's cores the sum of the
+    workers' and the parent's (to the 3 decimals printed); at the stop the log has each
+    worker's cores over the run.
+    """
+    proc = launch(FLEET, '-p', 'inertia:=[1.0, 2.0, 3.0]', '--', '--bodies', '4',
+                  '--processes', '2', name='fleet')
+    probe.subscribe(DiagnosticArray, '/diagnostics')
+    newest = {}
+
+    def measured():
+        for array in probe.messages['/diagnostics'][-8:]:
+            for status in array.status:
+                if status.name.startswith('attitude_fleet: '):
+                    newest[status.name] = status_values(status)
+        names = ['attitude_fleet: worker 1', 'attitude_fleet: worker 2', 'attitude_fleet: fleet']
+        return all(n in newest and newest[n].get('CPU (cores)', newest[n].get(
+            'CPU of the workers and the parent (cores)')) not in (None, 'not measured yet')
+            for n in names)
+    probe.spin_until(measured, 30.0, 'the CPU of both workers and of the fleet')
+    seen = len(probe.messages['/diagnostics'])
+    probe.spin_until(lambda: len(probe.messages['/diagnostics']) > seen + 20, 20.0,
+                     'a few more seconds of diagnostics')
+    newest.clear()
+    measured()
+    workers_now = [newest[f'attitude_fleet: worker {k}'] for k in (1, 2)]
+    for values in workers_now:
+        reported = float(values['CPU time (s)'])
+        assert 0.0 <= _proc_cpu(int(values['pid'])) - reported < 0.3 + 1e-9, values
+        assert 0.001 < float(values['CPU (cores)']) < 1.0, values
+        assert float(values['CPU per body (% of a core)']) == pytest.approx(
+            100.0 * float(values['CPU (cores)']) / 2, abs=0.06)     # (both rounded)
+    fleet = newest['attitude_fleet: fleet']
+    assert fleet['workers running'] == '2' and fleet['bodies'] == '4'
+    parts = sum(float(v['CPU (cores)']) for v in workers_now) + float(
+        fleet['CPU of the parent (cores)'])
+    assert float(fleet['CPU of the workers and the parent (cores)']) == pytest.approx(
+        parts, abs=2e-3)
+    stop_fleet(proc)
+    summary = [line for line in proc.output().splitlines() if 'CPU over the run' in line]
+    assert len(summary) == 1 and 'cores for 4 bodies' in summary[0] and \
+        'worker 1 0.' in summary[0] and 'worker 2 0.' in summary[0], summary
+
+
 def test_a_worker_that_dies_is_reported_and_fails_the_fleet(launch, probe):
     """SIGKILL one worker: ERROR on /diagnostics and in the log, the other runs on, exit 1."""
     proc = launch(FLEET, '-p', 'publish_rate:=50.0', '--', '--bodies', '2', '--processes', '2',
@@ -162,7 +218,7 @@ def test_no_worker_outlives_a_killed_parent(launch, probe):
     proc = launch(FLEET, '--', '--bodies', '2', '--processes', '2', name='fleet')
     probe.subscribe(DiagnosticArray, '/diagnostics')
     pids = [int(v['pid']) for v in workers(probe, 2).values()]
-    proc.proc.kill()
+    proc.kill()
     proc.proc.wait(5.0)
     probe.spin_until(lambda: not any(alive(pid) for pid in pids), 10.0, 'the workers gone')
     assert 'Traceback' not in proc.output()

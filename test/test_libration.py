@@ -25,7 +25,7 @@ MOMENTS = (2.0, 3.0, 1.2)           # I_y > I_x > I_z: the Lagrange region
 
 
 def _fly(moments, turn, tilt, elements=None, steps=8000, dt=10.0, torque=(0.0, 0.0, 0.0)):
-    """Integrate under the gravity gradient (and a held body torque, N m) from LVLH * tilt * turn."""
+    """Integrate under the gravity gradient (and a held torque, N m) from LVLH * tilt * turn."""
     orbit = KeplerOrbit(elements or circular_elements(500e3, inclination=1.0, raan=0.3))
     env = SpaceEnvironment(orbit, None, [GravityGradient(moments, MU_EARTH)])
     r, v = orbit.state(0.0)
@@ -106,7 +106,7 @@ def test_the_principal_axes_along_lvlh_are_found_and_an_unstable_one_said_so():
 
 
 def _jacobi(moments, n, trajectory):
-    """The Jacobi integral at each sample of a trajectory (J), from its positions and attitudes."""
+    """Return the Jacobi integral (J) at each sample and omega - n h_B (rad/s, body)."""
     _, q, w, _ = trajectory.principal()
     r, v = trajectory.position, trajectory.velocity
     h = np.cross(r, v)

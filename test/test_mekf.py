@@ -145,7 +145,7 @@ def test_vector_updates_alone_converge_consistently():
 
 
 def _ar1(seed, phi, n, columns=None):
-    """A stationary AR(1) series of unit variance, coefficient phi: (n,) or (n, columns)."""
+    """Return a stationary AR(1) series of unit variance, coefficient phi: (n,) or (n, m)."""
     shape = (n + 1000,) if columns is None else (n + 1000, columns)
     w = np.random.default_rng(seed).standard_normal(shape)
     return lfilter([math.sqrt(1.0 - phi * phi)], [1.0, -phi], w, axis=0)[1000:]

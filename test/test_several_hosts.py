@@ -26,7 +26,7 @@ FLEET = 'rigid_body_dynamics.nodes.fleet'
 
 
 def made_hosts(names):
-    """Make hosts ``names`` on a private subnet (skip where this machine cannot, unless required)."""
+    """Make hosts ``names`` on a private subnet (skip where impossible, unless required)."""
     reason = netns.unavailable()
     if reason and os.environ.get('RBD_REQUIRE_NETNS'):
         pytest.fail(f'RBD_REQUIRE_NETNS is set, but no network namespaces here: {reason}')

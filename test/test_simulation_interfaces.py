@@ -281,3 +281,57 @@ def test_the_step_simulation_example_lands_where_simulate_does(launch):
                .split() if x.lstrip('-').replace('.', '').isdigit()]
     np.testing.assert_allclose(numbers[1:5], q_ref, rtol=0, atol=1e-9)
     np.testing.assert_allclose(numbers[5:8], w_ref, rtol=0, atol=1e-9)
+
+
+def _fill(msg, values):
+    """Set a message's fields from a YAML mapping (nested mappings into nested messages)."""
+    for key, value in values.items():
+        if isinstance(value, dict):
+            _fill(getattr(msg, key), value)
+        else:
+            setattr(msg, key, value)
+    return msg
+
+
+def _manual_commands():
+    """Return the how-to's ros2 service call / action send_goal lines, split as a shell would."""
+    import re
+    import shlex
+    page = os.path.join(os.path.dirname(__file__), '..', 'doc', 'howto',
+                        'simulation_interfaces.md')
+    with open(page) as f:
+        blocks = re.findall(r'^```bash\n(.*?)^```', f.read(), re.S | re.M)
+    return [shlex.split(line) for block in blocks for line in block.splitlines()
+            if line.startswith(('ros2 service call', 'ros2 action send_goal'))]
+
+
+def test_the_manuals_command_lines_are_answered_as_written(launch, probe):
+    """
+    The how-to's ros2 service call and action send_goal lines, made through rclpy.
+
+    ros2cli has no wheel, so each line's service or action name, type and YAML request are
+    taken as written and sent from the probe: every answer is RESULT_OK (the pause first,
+    then the steps, then play), and the simulated time moved by exactly the 200 steps.
+    """
+    import importlib
+    import yaml
+    commands = _manual_commands()
+    assert [c[3] for c in commands] == ['/set_simulation_state', '/step_simulation',
+                                        '/simulate_steps', '/set_simulation_state'], commands
+    started(launch, probe, '-p', 'publish_clock:=true')
+    stamps = []
+    for words in commands:
+        kind, name, type_name, request = words[2], words[3], words[4], yaml.safe_load(words[5])
+        package, group, leaf = type_name.split('/')
+        interface = getattr(importlib.import_module(f'{package}.{group}'), leaf)
+        if kind == 'call':
+            response = probe.call(interface, name, _fill(interface.Request(), request))
+            assert response.result.result == OK, (words, response.result.error_message)
+        else:
+            assert kind == 'send_goal' and '--feedback' in words[6:]
+            status, result, _ = step_action(probe, _fill(interface.Goal(), request).steps)
+            assert status == GoalStatus.STATUS_SUCCEEDED and result.result.result == OK, words
+        if len(stamps) < 3:                 # paused, then after each stepping command
+            stamps.append(entity(probe)[0])
+    assert np.diff(stamps).tolist() == [100_000_000, 100_000_000], stamps
+    assert call(probe, 'get_simulation_state', None).state.state == SimulationState.STATE_PLAYING

@@ -108,7 +108,7 @@ def _tracker_readings(seed, n):
 
 
 def _tracker_errors(truths, readings):
-    """The rotation from truth to reading in the tracker frame, less the misalignment (n, 3)."""
+    """Return the rotation from truth to reading in the tracker frame, less the misalignment."""
     measured = Rotation.from_quat([r.q for r in readings])
     in_tracker = MOUNT.inv() * truths.inv() * measured * MOUNT
     return (Rotation.from_rotvec(MISALIGNMENT).inv() * in_tracker).as_rotvec()
@@ -195,7 +195,7 @@ SUN_NOISE = 1e-3
 
 
 def _sun_angles2(seed, n):
-    """Return the squared pointing errors (rad^2) of a sun sensor's readings in its field of view."""
+    """Return the squared pointing errors (rad^2) of a sun sensor's readings in its view."""
     sensor = SunSensor(10.0, SUN_NOISE, boresight=(1.0, 0.0, 0.0), fov=math.radians(60.0))
     rng = np.random.default_rng(seed)
     truths = Rotation.from_euler('xyz', np.random.default_rng(seed + 1).uniform(-0.5, 0.5, (n, 3)))

@@ -21,7 +21,8 @@ def detumble(body, law, duration, target_rate=math.radians(0.5)):
     readings are the control period). Returns a dict: the
     sample ``times`` (s), ``rates`` |omega| (rad/s), ``omegas`` (rad/s) and
     ``attitudes`` (x, y, z, w, body -> world) in the user's body frame, and
-    ``dipoles`` (A m^2, body) at each, and ``reached`` the first time (s) |omega| <= ``target_rate`` (rad/s),
+    ``dipoles`` (A m^2, body) at each, and ``reached`` the first time (s)
+    |omega| <= ``target_rate`` (rad/s),
     or None.
     """
     every = body.every('magnetometer')

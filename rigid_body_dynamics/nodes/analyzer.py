@@ -159,9 +159,9 @@ PARAMETERS = ParameterTable([
           'finite amplitudes differ by about the squared angle.', low=0.0, high=1.0,
           above_low=True),
     Param('estimation_confidence', 'double', 0.95, '0.95',
-          "Confidence of the mean NEES interval of the estimation status: a consistent "
-          "estimator is called overconfident or pessimistic in a share 1 - this of windows "
-          "(0.9999 for a test that must not fail by chance).", low=0.5, high=1.0 - 1e-9),
+          'Confidence of the mean NEES interval of the estimation status: a consistent '
+          'estimator is called overconfident or pessimistic in a share 1 - this of windows '
+          '(0.9999 for a test that must not fail by chance).', low=0.5, high=1.0 - 1e-9),
 ], cross_checks=(_wheels,))
 
 

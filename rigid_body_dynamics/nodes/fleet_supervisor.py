@@ -12,7 +12,11 @@ the bodies whose /tf must stop). The parent's own node
 with its exit code and its bodies) every second and at once on a death. The fleet's rules
 hold across the workers: one /clock source at most, and no /tf from bodies that share frames.
 
-The worker's stdin is its lifeline: when it closes (the parent stops, or dies even by
+Each worker's status carries its CPU (cores, over the last period, and seconds since it
+started, from /proc), and an ``attitude_fleet: fleet`` status the sum over the workers
+and the parent, so that what the fleet costs is seen on the graph; the exit log says
+the same over the whole run. The worker's stdin is its lifeline: when it closes (the
+parent stops, or dies even by
 SIGKILL) the worker stops cleanly as on SIGINT, so no worker outlives its fleet.
 """
 
@@ -47,6 +51,46 @@ EXIT_WAIT = 8.0
 #: The command that starts a worker: the console entry point (it owns SIGINT from its first
 #: instant), then the fleet's own options and the user's ROS arguments.
 WORKER = ('import sys; from rigid_body_dynamics.nodes.entry import fleet; sys.exit(fleet())',)
+
+
+def cpu_seconds(pid):
+    """
+    Return the user + system CPU time (s) of process ``pid`` (all its threads), or None.
+
+    From /proc/<pid>/stat (Linux); None where it cannot be read (another system, or the
+    process has been reaped).
+    """
+    try:
+        with open(f'/proc/{pid}/stat') as f:
+            fields = f.read().rsplit(')', 1)[1].split()
+    except (OSError, IndexError):
+        return None
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+class CpuMeter:
+    """The CPU of one process: seconds since it started, and cores over the last reading."""
+
+    def __init__(self, pid):
+        self.pid, self.started = pid, time.monotonic()
+        self.total, self.cores = 0.0, None
+        self._last = (self.started, 0.0)
+
+    def read(self):
+        """Take a reading (keeps the last one if the process is gone); return the cores."""
+        used = cpu_seconds(self.pid)
+        now = time.monotonic()
+        if used is not None:
+            then, before = self._last
+            if now > then:
+                self.cores = (used - before) / (now - then)
+            self.total, self._last = used, (now, used)
+        return self.cores
+
+    def average(self):
+        """Return the cores averaged since the process started (to the last reading)."""
+        span = self._last[0] - self.started
+        return self.total / span if span > 0.0 else None
 
 
 def default_processes(bodies):
@@ -128,6 +172,7 @@ class Worker:
         self.report_pipe = os.fdopen(read)
         self.report = None
         self.death = None           # the exit code of a death before the stop
+        self.cpu = CpuMeter(self.proc.pid)
 
     @property
     def pid(self):
@@ -162,6 +207,9 @@ class Worker:
         bodies = ', '.join(self.names)
         values = [('pid', self.pid), ('bodies', bodies), ('body count', len(self.names))]
         if code is None:
+            self.cpu.read()
+        values += _cpu_values(self.cpu, len(self.names))
+        if code is None:
             level, message = DiagnosticStatus.OK, f'running {len(self.names)} bodies'
         else:
             level = DiagnosticStatus.ERROR
@@ -169,6 +217,15 @@ class Worker:
             values.append(('exit code', code))
         return status(f'{NODE_NAME}: worker {self.index + 1}', level, message, values,
                       hardware_id)
+
+
+def _cpu_values(meter, bodies):
+    """Return the CPU keys of a status: cores over the last period, per body, seconds in all."""
+    cores = meter.cores
+    return [('CPU (cores)', 'not measured yet' if cores is None else f'{cores:.3f}'),
+            ('CPU per body (% of a core)',
+             'not measured yet' if cores is None else f'{100.0 * cores / max(1, bodies):.2f}'),
+            ('CPU time (s)', f'{meter.total:.2f}')]
 
 
 def describe(code):
@@ -186,6 +243,7 @@ class Supervisor:
 
     def __init__(self, groups, argv, stop):
         self.stop, self.workers = stop, []
+        self.own_cpu = CpuMeter(os.getpid())
         self.node = rclpy.create_node(NODE_NAME)
         self.logger = self.node.get_logger()
         self._pub = self.node.create_publisher(DiagnosticArray, '/diagnostics', 10)
@@ -244,11 +302,47 @@ class Supervisor:
             self.stop.wait(WATCH_PERIOD)
 
     def publish_diagnostics(self):
-        """One DiagnosticArray with a status per worker."""
+        """One DiagnosticArray: a status per worker, and the fleet's (CPU of all together)."""
         msg = DiagnosticArray()
         msg.header.stamp = self.node.get_clock().now().to_msg()
-        msg.status = [w.status(self.node.get_fully_qualified_name()) for w in self.workers]
+        hardware_id = self.node.get_fully_qualified_name()
+        msg.status = [w.status(hardware_id) for w in self.workers]
+        self.own_cpu.read()
+        running = [w for w in self.workers if w.death is None]
+        cores = [w.cpu.cores for w in running] + [self.own_cpu.cores]
+        bodies = sum(len(w.names) for w in self.workers)
+        total = None if None in cores else sum(cores)
+        text = 'not measured yet' if total is None else f'{total:.3f}'
+        values = [('workers', len(self.workers)), ('workers running', len(running)),
+                  ('bodies', bodies),
+                  ('CPU of the workers and the parent (cores)', text),
+                  ('CPU per body (% of a core)', 'not measured yet' if total is None else
+                   f'{100.0 * total / max(1, bodies):.2f}'),
+                  ('CPU of the parent (cores)', 'not measured yet' if self.own_cpu.cores is None
+                   else f'{self.own_cpu.cores:.3f}')]
+        level = DiagnosticStatus.OK if len(running) == len(self.workers) else \
+            DiagnosticStatus.ERROR
+        msg.status.append(status(f'{NODE_NAME}: fleet', level,
+                                 f'{len(running)} of {len(self.workers)} workers running '
+                                 f'{bodies} bodies, {text} cores', values, hardware_id))
         self._pub.publish(msg)
+
+    def cpu_summary(self):
+        """Say what the fleet cost over its run: each worker's cores and all together."""
+        for worker in self.workers:
+            if worker.death is None:
+                worker.cpu.read()
+        self.own_cpu.read()
+        parts = [(f'worker {w.index + 1}', w.cpu.average(), len(w.names)) for w in self.workers]
+        known = [c for _, c, _ in parts if c is not None]
+        own = self.own_cpu.average() or 0.0
+        bodies = sum(len(w.names) for w in self.workers)
+        every = ', '.join(f'{name} {c:.3f}' if c is not None else f'{name} not measured'
+                          for name, c, _ in parts)
+        total = sum(known) + own
+        return (f'CPU over the run: {total:.3f} cores for {bodies} bodies '
+                f'({100.0 * total / max(1, bodies):.2f} % of a core each): {every}, '
+                f'the parent {own:.3f}')
 
     def finish(self):
         """
@@ -257,6 +351,7 @@ class Supervisor:
         Returns the fleet's exit code: 0 if every worker ran until the stop and exited 0,
         else 1.
         """
+        summary = self.cpu_summary()
         for worker in self.workers:
             worker.release()
             if worker.proc.poll() is None:
@@ -275,6 +370,7 @@ class Supervisor:
                 self.logger.error(f'worker {worker.index + 1} (pid {worker.pid}) exited with '
                                   f'{describe(code)}')
                 failed.append(worker)
+        self.logger.info(summary)
         self.node.destroy_node()
         return 1 if failed else 0
 

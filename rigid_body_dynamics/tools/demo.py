@@ -28,11 +28,11 @@ import time
 
 import numpy as np
 
+from .libration_scene import LIBRATION, libration_offline, run_libration
 from ..physics import FreeRigidBody, INTEGRATORS, presets, quaternions, simulate
 from ..physics.analysis import analyse, Trajectory
 from ..physics.analysis.findings_render import text_lines
 from ..physics.control import QuaternionPD, settling_time
-from .libration_scene import LIBRATION, libration_offline, run_libration
 
 #: The closed-loop scene: 30 degrees about x from rest, wn 2 rad/s, zeta 0.7, 100 Hz, 10 s.
 SLEW = {'target': (math.sin(math.radians(15.0)), 0.0, 0.0, math.cos(math.radians(15.0))),

@@ -58,9 +58,10 @@ def parameters(scene=LIBRATION_SCENE):
 
 def _headline(how):
     s = LIBRATION_SCENE
+    height = (s['orbit_elements'][0] - 6378137.0) / 1e3
     return (f'{LIBRATION}: the gravity gradient holds a satellite (I = {tuple(s["inertia"])} '
-            f'kg m^2) near the local vertical of a {(s["orbit_elements"][0] - 6378137.0) / 1e3:.0f}'
-            f' km circular orbit, released turning with it {how}; over {s["window"]:.0f} s:')
+            f'kg m^2) near the local vertical of a {height:.0f} km circular orbit, released '
+            f'turning with it {how}; over {s["window"]:.0f} s:')
 
 
 def libration_offline():

@@ -158,7 +158,8 @@ class EstimationFindings:
     integrated autocorrelation time (samples) of the NEES, and
     ``independent`` = samples / correlation, the independent samples the bounds
     count; ``bounds`` the two-sided chi-square interval of confidence ``level``
-    (0.95 unless asked) of the mean NEES for 3 ``independent`` degrees of freedom; ``verdict`` 'consistent', 'overconfident'
+    (0.95 unless asked) of the mean NEES for 3 ``independent`` degrees of freedom;
+    ``verdict`` 'consistent', 'overconfident'
     (NEES above the interval), 'pessimistic' (below) or 'unavailable'. With a
     bias estimate and the true bias: ``bias_rms`` (3,) rad/s.
     """

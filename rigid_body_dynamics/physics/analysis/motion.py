@@ -656,7 +656,8 @@ def estimation(q_true, q_est, covariances, bias_true=None, bias_est=None, level=
         bias_rms = np.sqrt(np.mean(d * d, axis=0))
     inside = float(np.mean(nees_k <= chi2.ppf(chi2.cdf(9.0, 1), 3)))
     message = (f'{verdict}: mean NEES {nees:.3g} for 3 expected ({100.0 * level:.4g} % interval '
-               f'{low:.3g} to {high:.3g} over {independent:.0f} independent samples of {n}); attitude '
+               f'{low:.3g} to {high:.3g} over {independent:.0f} independent samples of {n}); '
+               'attitude '
                f'error {math.sqrt(np.mean(angles ** 2)):.3g} rad RMS')
     return EstimationFindings(
         OK if verdict == 'consistent' else WARN, message, verdict, n,
