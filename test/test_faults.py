@@ -91,6 +91,7 @@ def test_a_node_that_does_not_stop_says_where_it_is_before_it_is_killed(
     sim = launch('rigid_body_dynamics.nodes.simulator', name='sim')
     probe.subscribe(Odometry, '/odom')
     probe.wait_for('/odom')                 # running: its threads exist
+    sim.handled = True                  # killed on purpose
     assert dump_and_kill(sim.proc) == -signal.SIGKILL
     output = sim.output()
     assert output.count('Thread 0x') + output.count('Current thread 0x') == 3, output
