@@ -9,7 +9,7 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak |
 soak-rt | flood | bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep |
 latency | publish | flow-batch | estimation | discovery | late-steps |
-bodies-wheels``
+bodies-wheels | fleet-check``
 runs one reliability / scale measurement (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
@@ -53,7 +53,8 @@ def main():
                                            'publish', 'flow-batch', 'command-path',
                                            'simulate-cost', 'wheels', 'wheels-node',
                                            'environment', 'environment-node', 'estimation',
-                                           'discovery', 'late-steps', 'bodies-wheels'],
+                                           'discovery', 'late-steps', 'bodies-wheels',
+                                           'fleet-check'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -123,6 +124,7 @@ SCALE = {
     'discovery': ('discovery', 'DDS discovery time and the number of participants'),
     'bodies-wheels': ('bodies_wheels', 'Many bodies with reaction wheels in fleets'),
     'late-steps': ('late_steps', 'Late steps in one fleet process, and what they waited for'),
+    'fleet-check': ('fleet_check', '96 asymmetric bodies at the defaults, watched'),
 }
 
 
