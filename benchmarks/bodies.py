@@ -3,8 +3,7 @@ Many bodies on one machine: how many run in real time at 1 kHz integration and 1
 
 Three ways, all with the defaults of the symmetric top (exact integrator, 7 state topics per
 body): one ``attitude_simulator`` process per body (a namespace each), ``attitude_fleet
---processes 1`` (every body in one process, sharing one integration thread; a thread per
-body, measured before: 4 bodies, was removed), and ``attitude_fleet --processes 2`` (the
+--processes 1`` (every body in one process, sharing one integration thread), and ``attitude_fleet --processes 2`` (the
 bodies round-robin over two worker processes, one per core; the CPU counts the parent and
 both workers). For each count N the bodies start, run until every one has reported, and then
 for a window the CPU of all processes is summed and every body's diagnostics are read. N

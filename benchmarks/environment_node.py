@@ -13,8 +13,8 @@ environments, the body alone and with four pyramid wheels (J = 0.01 kg m^2, Coul
 and viscous 1e-6 N m s friction, spinning at (40, -25, 10, 0.5) rad/s, motors idle: without
 the orbit's torques, their steps between two reads of the state, every 10, are one span); in
 orbit each twice: with the models' statements in the generated stages (as the package runs)
-and with the models called at every stage (``SpaceEnvironment(..., stages=False)``, how every
-step ran before the statements). ``./dev bench --only environment-node``.
+and with the models called at every stage (``SpaceEnvironment(...,
+stages=False)``, the path of a model without statements). ``./dev bench --only environment-node``.
 """
 
 import statistics

@@ -198,7 +198,7 @@ def summarise(events):
 
 
 #: (label, environment of the probe): the fleet without and with gc.freeze after start-up.
-SETUPS = (('without gc.freeze (as before)', {'LATE_STEPS_NO_FREEZE': '1'}),
+SETUPS = (('without gc.freeze', {'LATE_STEPS_NO_FREEZE': '1'}),
           ('gc.freeze after start-up', {}))
 
 

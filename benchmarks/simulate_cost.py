@@ -13,9 +13,7 @@ crossings, with torque-free segments on the exact flow). Cost is wall time per s
 second (least of five), also over a plain pure-Python RK4 at 1 ms (``torque.plain_rk4``,
 the unit the cost targets are stated in) measured in the same run. Accuracy: the largest
 attitude error (rad) at the 10 ms holds against scipy's DOP853 at rtol 2.5e-14
-(``zoh_reference``), in the principal frame. (The comparison with the revision before the
-one command path, 68c4864, ended with the physics sub-packages, which its scripts predate:
-its figures are in this file's history.) ``./dev bench --only simulate-cost``.
+(``zoh_reference``), in the principal frame.  ``./dev bench --only simulate-cost``.
 """
 
 import math

@@ -30,8 +30,7 @@ the gyrostat with the four pyramid wheels (J = 0.01 kg m^2, speeds (40, -25, 10,
 rad/s, motor torques (0.01, -0.02, 0.005, 0) N m) without external torque and under the
 same held torque, without and with friction (wheels.yaml's Coulomb 1e-4 N m and viscous
 1e-6 N m s); the asymmetric body I = (1, 2, 3) kg m^2, omega0 = (0.3, 1.5, -0.4) rad/s.
-Before the gyrostat's step was unrolled (commit ab2afd7, on AMD EPYC 2 cores on 2026-12-03,
-as the table below): 88-99 us, 12.3-13.8 times the plain body's.
+
 ``./dev bench --only wheels`` (Basilisk installed: ``pip install bsk==2.12.1``).
 """
 

@@ -6,13 +6,11 @@ pyramid wheels of ``doc/examples/wheels.yaml`` held at zero motor torque, and wi
 wheels driven (a wheel_cmd publisher at 100 Hz in the same process as the probe); CPU is the
 simulator's share of one core over 8 s after 3 s of warm-up, each case twice, alternating,
 on the idle machine and beside one CPU-bound process (``while 1: pass``, started and ended by
-the benchmark). On this virtual machine the same code measured three times more a few hours
-apart (commit 4d8e198, 2026-12-03, idle: no wheels 0.036 and 0.061, four wheels at 0 0.104
-and 0.115, driven 0.127 and 0.150), so a figure here holds for its run. With wheels every
+the benchmark). On this virtual machine a
+figure holds for its run: the same code has measured up to three times more on another day. With wheels every
 step is a Runge-Kutta step of the gyrostat (order 6 or 8; no exact torque-free flow to skip
 steps on), so the figure is the cost of the gyrostat in a node.
-Before the gyrostat's step was unrolled (commit ab2afd7, on AMD EPYC 2 cores on 2026-12-03):
-no wheels 0.053, four wheels at 0 0.259, driven 0.308 of a core (medians of two).
+
 ``./dev bench --only wheels-node``.
 """
 
