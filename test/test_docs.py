@@ -352,3 +352,12 @@ def test_the_readme_is_a_short_landing_page_whose_links_resolve():
     links = re.findall(r'\]\(([^)#]+)\)', readme)
     assert len(links) > 20
     assert [link for link in links if not (ROOT / link).exists()] == []
+
+
+def test_the_readme_lists_every_page_of_the_manual():
+    """README's list of the manual names each tutorial, how-to and explanation page."""
+    readme = (ROOT / 'README.md').read_text()
+    pages = [p.relative_to(ROOT).as_posix() for folder in ('tutorials', 'howto', 'explanation')
+             for p in sorted((DOC / folder).glob('*.md'))] + ['doc/benchmarks.md']
+    missing = [p for p in pages if f']({p})' not in readme]
+    assert not missing, missing
