@@ -3,15 +3,15 @@ Many bodies on one machine: how many run in real time at 1 kHz integration and 1
 
 Three ways, all with the defaults of the symmetric top (exact integrator, 7 state topics per
 body): one ``attitude_simulator`` process per body (a namespace each), ``attitude_fleet
---processes 1`` (every body in one process, sharing one integration thread), and ``attitude_fleet --processes 2`` (the
-bodies round-robin over two worker processes, one per core; the CPU counts the parent and
-both workers). For each count N the bodies start, run until every one has reported, and then
-for a window the CPU of all processes is summed and every body's diagnostics are read. N
-runs in real time when every body achieved a real-time factor of at least 0.99 and at most 2
-of its steps were more than 5 ms late in the window (the criterion of the single-node rate
-sweep, per body; in one process a single 5 ms stall of the machine makes every body late at
-once, so the total counts each stall N times). Each sweep ends after two failures in a row.
-``./dev bench --only bodies`` (about 25 minutes).
+--processes 1`` (every body in one process, sharing one integration thread), and
+``attitude_fleet --processes 2`` (the bodies round-robin over two worker processes, one per
+core; the CPU counts the parent and both workers). For each count N the bodies start, run until
+every one has reported, and then for a window the CPU of all processes is summed and every
+body's diagnostics are read. N runs in real time when every body achieved a real-time factor of
+at least 0.99 and at most 2 of its steps were more than 5 ms late in the window (the criterion
+of the single-node rate sweep, per body; in one process a single 5 ms stall of the machine
+makes every body late at once, so the total counts each stall N times). Each sweep ends after
+two failures in a row. ``./dev bench --only bodies`` (about 25 minutes).
 """
 
 import os

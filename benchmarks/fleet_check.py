@@ -29,7 +29,7 @@ FLEET = [sys.executable, '-m', 'rigid_body_dynamics.nodes.fleet']
 BODIES = 96
 WINDOW = 10.0
 #: The checker: /diagnostics and the odom of four bodies, in a process of its own.
-CHECKER = '''
+CHECKER = """
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray
 from nav_msgs.msg import Odometry
@@ -42,11 +42,11 @@ try:
     rclpy.spin(node)
 except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
     pass
-'''
+"""
 
 
 def fleet_status(probe, since):
-    """The newest attitude_fleet statuses from ``since`` on: {name: values}."""
+    """Return the newest attitude_fleet statuses from ``since`` on: {name: values}."""
     found = {}
     for array in probe.messages['/diagnostics'][since:]:
         for status in array.status:

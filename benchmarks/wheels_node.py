@@ -7,8 +7,9 @@ wheels driven (a wheel_cmd publisher at 100 Hz in the same process as the probe)
 simulator's share of one core over 8 s after 3 s of warm-up, each case twice, alternating,
 on the idle machine and beside one CPU-bound process (``while 1: pass``, started and ended by
 the benchmark). On this virtual machine a
-figure holds for its run: the same code has measured up to three times more on another day. With wheels every
-step is a Runge-Kutta step of the gyrostat (order 6 or 8; no exact torque-free flow to skip
+figure holds for its run: the same code has measured up to three times more on another
+day. With wheels every step is a Runge-Kutta step of the gyrostat (order 6 or 8; no exact
+torque-free flow to skip
 steps on), so the figure is the cost of the gyrostat in a node.
 
 ``./dev bench --only wheels-node``.

@@ -11,6 +11,13 @@ def _demo(*args):
                           capture_output=True, text=True, timeout=120, env=os.environ.copy())
 
 
+def _example(name):
+    """Return the parameters file doc/examples/``name``, loaded."""
+    import yaml
+    with open(os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples', name)) as f:
+        return yaml.safe_load(f)
+
+
 def _relative_errors(text):
     return [float(x) for x in re.findall(r'\(rel\. ([0-9.e+-]+)[,)]', text)]
 
@@ -103,12 +110,8 @@ def test_demo_satellite_scene_in_lockstep_and_offline():
 
 def test_the_manuals_satellite_yaml_is_the_demos_scene():
     """doc/examples/satellite.yaml says what the demo's satellite scene runs."""
-    import os
-    import yaml
     from rigid_body_dynamics.tools.demo import _satellite_parameters
-    path = os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples', 'satellite.yaml')
-    with open(path) as f:
-        config = yaml.safe_load(f)
+    config = _example('satellite.yaml')
     shared, sim, ctl = _satellite_parameters()
     assert config['/**']['ros__parameters'] == shared
     assert config['/**/attitude_simulator']['ros__parameters'] == sim
@@ -118,12 +121,8 @@ def test_the_manuals_satellite_yaml_is_the_demos_scene():
 def test_the_manuals_libration_yaml_is_the_demos_scene():
     """doc/examples/libration.yaml: the scene's values, the initial rate (0, -n, 0) + offset."""
     import math
-    import os
-    import yaml
     from rigid_body_dynamics.tools.libration_scene import LIBRATION_SCENE, parameters
-    path = os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples', 'libration.yaml')
-    with open(path) as f:
-        config = yaml.safe_load(f)
+    config = _example('libration.yaml')
     shared, sim, analyzer = parameters()
     assert config['/**']['ros__parameters'] == shared
     assert config['/**/attitude_simulator']['ros__parameters'] == sim

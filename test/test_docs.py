@@ -355,7 +355,7 @@ def test_the_readme_is_a_short_landing_page_whose_links_resolve():
 
 
 def test_the_readme_lists_every_page_of_the_manual():
-    """README's list of the manual names each tutorial, how-to and explanation page."""
+    """Check that README's list of the manual names each tutorial, how-to and explanation."""
     readme = (ROOT / 'README.md').read_text()
     pages = [p.relative_to(ROOT).as_posix() for folder in ('tutorials', 'howto', 'explanation')
              for p in sorted((DOC / folder).glob('*.md'))] + ['doc/benchmarks.md']

@@ -24,11 +24,26 @@ def _guard():
     return received
 
 
+def exiting(code):
+    """
+    Ignore SIGINT and SIGTERM from now on, and return ``code``: the process is ending.
+
+    A process on its way out that gets one more signal (a Ctrl-C reaches a fleet's
+    parent and its workers at once, and the parent then stops each worker too) would
+    otherwise die of it: Python's finalisation puts the default action back on the
+    signals it handled, and Fast DDS's teardown can take a second. SIGKILL still works.
+    Call it in a process's main only, never where the process goes on (a test).
+    """
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, signal.SIG_IGN)
+    return code
+
+
 def _entry(module, executable):
     """Make the console entry point of ``executable``: guard first, then import ``module``."""
     def entry():
         early = _guard()
-        return importlib.import_module(f'{__package__}.{module}').main(early=early)
+        return exiting(importlib.import_module(f'{__package__}.{module}').main(early=early))
     entry.__doc__ = f'Entry point of {executable}.'
     return entry
 

@@ -203,4 +203,5 @@ def _start_when_told(fleet):
 
 
 if __name__ == '__main__':
-    sys.exit(main())
+    from .entry import exiting
+    sys.exit(exiting(main()))

@@ -202,4 +202,5 @@ def main(args=None, early=None):
 
 
 if __name__ == '__main__':
-    sys.exit(main())
+    from .entry import exiting
+    sys.exit(exiting(main()))

@@ -199,7 +199,9 @@ PARAMETERS = ParameterTable([
           "Offer ROS 2's standard simulator services and action (simulation_interfaces: "
           'get_simulator_features, step_simulation, simulate_steps, get_entity_state, ...) in '
           "the node's namespace, where the package is importable. attitude_fleet leaves them "
-          'off unless set: 24 more DDS endpoints per body (8 services and an action: a reader and a writer per service, 3 services and 2 topics per action) made 128 bodies start in 20-26 s '
+          'off unless set: 24 more DDS endpoints per body (8 services and an action: a reader '
+          'and a writer per service, 3 services and 2 topics per action) made 128 bodies '
+          'start in 20-26 s '
           'instead of 7-8 and exit in 7.5-10 s instead of 3-3.5.',
           read_only=True),
     Param('thread_priority', 'int', 0, '0',
