@@ -373,13 +373,15 @@ def test_ctrl_c_to_the_whole_group_exits_zero(probe, tmp_path):
     odom = [probe.subscribe(Odometry, f'/sat_{c}/odom') for c in 'abc']
     for run in range(5):
         log = open(tmp_path / f'fleet{run}.log', 'w')
+        began = time.time_ns()
         fleet = subprocess.Popen([sys.executable, '-m', FLEET, '--names', 'sat_a,sat_b,sat_c',
                                   '--ros-args', '-p', 'publish_rate:=50.0'],
                                  stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
         try:
-            counts = [len(o) for o in odom]
-            probe.spin_until(lambda: all(len(o) > c + 5 for o, c in zip(odom, counts)), 30.0,
-                             'every body publishing')
+            # (a stamp after this run began: a late message of the run before is no sign)
+            def fresh(messages, began=began):
+                return sum(time_ns(m.header.stamp) > began for m in messages) > 5
+            probe.spin_until(lambda: all(fresh(o) for o in odom), 30.0, 'every body publishing')
             os.killpg(fleet.pid, signal.SIGINT)
             code = fleet.wait(10.0)
         finally:
