@@ -219,12 +219,17 @@ class Worker:
                       hardware_id)
 
 
+def _cores(cores, bodies=None):
+    """Say ``cores`` (or their share per body, % of a core): 'not measured yet' for None."""
+    if cores is None:
+        return 'not measured yet'
+    return f'{cores:.3f}' if bodies is None else f'{100.0 * cores / max(1, bodies):.2f}'
+
+
 def _cpu_values(meter, bodies):
     """Return the CPU keys of a status: cores over the last period, per body, seconds in all."""
-    cores = meter.cores
-    return [('CPU (cores)', 'not measured yet' if cores is None else f'{cores:.3f}'),
-            ('CPU per body (% of a core)',
-             'not measured yet' if cores is None else f'{100.0 * cores / max(1, bodies):.2f}'),
+    return [('CPU (cores)', _cores(meter.cores)),
+            ('CPU per body (% of a core)', _cores(meter.cores, bodies)),
             ('CPU time (s)', f'{meter.total:.2f}')]
 
 
@@ -312,19 +317,16 @@ class Supervisor:
         cores = [w.cpu.cores for w in running] + [self.own_cpu.cores]
         bodies = sum(len(w.names) for w in self.workers)
         total = None if None in cores else sum(cores)
-        text = 'not measured yet' if total is None else f'{total:.3f}'
         values = [('workers', len(self.workers)), ('workers running', len(running)),
                   ('bodies', bodies),
-                  ('CPU of the workers and the parent (cores)', text),
-                  ('CPU per body (% of a core)', 'not measured yet' if total is None else
-                   f'{100.0 * total / max(1, bodies):.2f}'),
-                  ('CPU of the parent (cores)', 'not measured yet' if self.own_cpu.cores is None
-                   else f'{self.own_cpu.cores:.3f}')]
+                  ('CPU of the workers and the parent (cores)', _cores(total)),
+                  ('CPU per body (% of a core)', _cores(total, bodies)),
+                  ('CPU of the parent (cores)', _cores(self.own_cpu.cores))]
         level = DiagnosticStatus.OK if len(running) == len(self.workers) else \
             DiagnosticStatus.ERROR
         msg.status.append(status(f'{NODE_NAME}: fleet', level,
                                  f'{len(running)} of {len(self.workers)} workers running '
-                                 f'{bodies} bodies, {text} cores', values, hardware_id))
+                                 f'{bodies} bodies, {_cores(total)} cores', values, hardware_id))
         self._pub.publish(msg)
 
     def cpu_summary(self):
@@ -333,13 +335,11 @@ class Supervisor:
             if worker.death is None:
                 worker.cpu.read()
         self.own_cpu.read()
-        parts = [(f'worker {w.index + 1}', w.cpu.average(), len(w.names)) for w in self.workers]
-        known = [c for _, c, _ in parts if c is not None]
+        averages = [w.cpu.average() for w in self.workers]
         own = self.own_cpu.average() or 0.0
         bodies = sum(len(w.names) for w in self.workers)
-        every = ', '.join(f'{name} {c:.3f}' if c is not None else f'{name} not measured'
-                          for name, c, _ in parts)
-        total = sum(known) + own
+        every = ', '.join(f'worker {k + 1} {_cores(c)}' for k, c in enumerate(averages))
+        total = sum(c for c in averages if c is not None) + own
         return (f'CPU over the run: {total:.3f} cores for {bodies} bodies '
                 f'({100.0 * total / max(1, bodies):.2f} % of a core each): {every}, '
                 f'the parent {own:.3f}')

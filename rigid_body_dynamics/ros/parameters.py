@@ -211,3 +211,19 @@ class ParameterTable:
         return '\n'.join(['| name | type | default | range | read-only | meaning |',
                           '| --- | --- | --- | --- | --- | --- |']
                          + [p.row() for p in self.params.values()])
+
+
+def write_parameters_file(sections):
+    """
+    Write ``sections`` ({node key: {name: value}}) as a ROS parameters file; return its path.
+
+    Each key ('/**', '/**/attitude_simulator', ...) gets its ``ros__parameters``; the
+    file is a temporary one, for the caller to remove.
+    """
+    import tempfile
+
+    import yaml
+    with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
+        yaml.safe_dump({key: {'ros__parameters': values} for key, values in sections.items()},
+                       f)
+    return f.name

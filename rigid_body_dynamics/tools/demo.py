@@ -136,21 +136,16 @@ def satellite_offline():
 
 def run_satellite():
     """Run the satellite scene on the nodes: the simulator in lockstep and B-dot."""
-    import tempfile
-
     from geometry_msgs.msg import Vector3Stamped
     from nav_msgs.msg import Odometry
     from rclpy.qos import QoSProfile, ReliabilityPolicy
-    import yaml
 
     from ..ros.client import interrupt, RosClient, start_node
     from ..ros.conversions import time_ns
+    from ..ros.parameters import write_parameters_file
     shared, sim_params, ctl_params = _satellite_parameters()
-    with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
-        yaml.safe_dump({'/**': {'ros__parameters': shared},
-                        '/**/attitude_simulator': {'ros__parameters': sim_params},
-                        '/**/attitude_controller': {'ros__parameters': ctl_params}}, f)
-        params = f.name
+    params = write_parameters_file({'/**': shared, '/**/attitude_simulator': sim_params,
+                                    '/**/attitude_controller': ctl_params})
     quiet = ['--log-level', 'warn', '--params-file', params]
     sim, ctl = start_node('simulator', list(quiet) + [
         '-p', 'qos_overrides./odom.publisher.depth:=10000',

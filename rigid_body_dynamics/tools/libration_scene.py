@@ -92,22 +92,17 @@ def libration_offline():
 
 def run_libration():
     """Run the scene on attitude_simulator and attitude_analyzer; the analyzer's orbit lines."""
-    import tempfile
-
     from diagnostic_msgs.msg import DiagnosticArray
     from nav_msgs.msg import Odometry
-    import yaml
 
     from ..nodes import analyzer_diagnostics as diagnostics
     from ..physics.analysis.findings_render import orbit_lines
     from ..ros.client import interrupt, RosClient, start_node
+    from ..ros.parameters import write_parameters_file
     from ..ros.conversions import status_values, time_ns
     shared, sim_params, analyzer_params = parameters()
-    with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
-        yaml.safe_dump({'/**': {'ros__parameters': shared},
-                        '/**/attitude_simulator': {'ros__parameters': sim_params},
-                        '/**/attitude_analyzer': {'ros__parameters': analyzer_params}}, f)
-        params = f.name
+    params = write_parameters_file({'/**': shared, '/**/attitude_simulator': sim_params,
+                                    '/**/attitude_analyzer': analyzer_params})
     end = round(LIBRATION_SCENE['window'] * 1e9)
     newest = {'odom': -1}
     orbit = {}
