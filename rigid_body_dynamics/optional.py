@@ -2,7 +2,8 @@
 The third-party modules that only some tools need, and the one-line error when one is missing.
 
 The nodes and the physics need numpy, scipy and the ROS messages only. The
-report needs matplotlib and plotly, the bag tools rosbags; a ROS user who never
+report needs matplotlib and plotly, the bag tools rosbags, an orbit from a TLE
+(``orbit_tle``) sgp4; a ROS user who never
 runs them may not have them (plotly has no rosdep key, so ``rosdep install``
 cannot bring it). A tool calls :func:`require` first, before any work, and a
 missing module ends it with one line saying what to install and exit status 2,
@@ -18,6 +19,7 @@ OPTIONAL = {
                    'python3-matplotlib'),
     'plotly': ('sudo apt install python3-plotly', 'pip install plotly', None),
     'rosbags': (None, 'pip install rosbags', 'python3-rosbags-pip'),
+    'sgp4': ('sudo apt install python3-sgp4', 'pip install sgp4', None),
 }
 
 

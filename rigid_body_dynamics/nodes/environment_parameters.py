@@ -9,10 +9,11 @@ values into the engine's
 that names the parameter.
 """
 
-from .sensor_parameters import sun_from
+from .sensor_parameters import epoch_of, sun_from
 from ..engine import Disturbances
-from ..physics.environment import (DipoleField, EARTH_RATE, IGRF13_2020, KeplerOrbit,
-                                   MU_EARTH, R_EARTH)
+from ..physics.environment import (DipoleField, EARTH_RATE, greenwich_mean_sidereal_time,
+                                   IGRF13_2020, julian_date, KeplerOrbit, MU_EARTH, R_EARTH,
+                                   TleOrbit)
 from ..ros.parameters import ConfigurationError, Param
 
 _IGRF = [float(c) for c in IGRF13_2020]
@@ -23,7 +24,13 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
           'Two-body orbit [a (m), e, i, RAAN, argument of perigee, true anomaly at t = 0 '
           "(rad)] in the world frame (inertial, z the planet's rotation axis), solved from "
           "Kepler's equation at every step; 0 <= e < 1 and the perigee above planet_radius. "
-          'Unset = no orbit (a free body).', read_only=True),
+          'Unset = no orbit (a free body, unless orbit_tle is set).', read_only=True),
+    Param('orbit_tle', 'string[2]', None, 'unset (no TLE)',
+          'The two lines of a TLE (NORAD two-line element set), flown by SGP4 (the sgp4 '
+          'library, WGS-72): the world frame is then TEME (true equator, mean equinox of '
+          'date), and simulated time 0 is epoch, or the TLE\'s epoch when epoch is unset. '
+          'Instead of orbit_elements (set one); orbit_mu is then WGS-72\'s 3.986008e14 '
+          'm^3/s^2.', read_only=True),
     Param('orbit_mu', 'double', MU_EARTH, '3.986004418e14 m^3/s^2',
           "The planet's gravitational parameter mu (m^3/s^2).", low=1e-30, high=1e30,
           read_only=True),
@@ -32,18 +39,20 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
           read_only=True),
     Param('gravity_gradient', 'bool', False, 'false',
           'The gravity-gradient torque 3 mu / |r|^5 (r_B x I r_B) on the orbit (needs '
-          'orbit_elements), evaluated at every integrator stage.', read_only=True),
+          'orbit_elements or orbit_tle), evaluated at every integrator stage.', read_only=True),
     Param('magnetic_field_model', 'string', 'none', '`none`',
           "The planet's magnetic field: none, or dipole (the centred tilted dipole of degree "
-          '1; needs orbit_elements). With a field the node takes magnetorquer_cmd.',
+          '1; needs orbit_elements or orbit_tle). With a field the node takes '
+          'magnetorquer_cmd.',
           read_only=True, choices=('dipole', 'none')),
     Param('magnetic_dipole_coefficients', 'double[3]', _IGRF,
           '[-29404.8, -1450.9, 4652.5] nT (IGRF-13, 2020.0)',
           'Gauss coefficients [g10, g11, h11] (nT) of the dipole field, reference radius '
           '6371.2 km.', read_only=True),
-    Param('earth_rotation_angle', 'double', 0.0, '0.0 rad',
-          'Angle of the Earth-fixed frame about the world z axis at t = 0 (rad).',
-          low=-1e6, high=1e6, read_only=True),
+    Param('earth_rotation_angle', 'double', None, 'unset (from the epoch)',
+          'Angle of the Earth-fixed frame about the world z axis at t = 0 (rad). Unset: the '
+          'Greenwich mean sidereal time (IAU 1982) of epoch (or of the TLE\'s epoch), 0.0 '
+          'without either.', low=-1e6, high=1e6, read_only=True),
     Param('earth_rotation_rate', 'double', EARTH_RATE, '7.292115e-05 rad/s',
           "The planet's rotation rate about z (rad/s): the field turns with it.",
           low=-1.0, high=1.0, read_only=True),
@@ -75,11 +84,55 @@ def environment_params(*names):
 
 
 def orbit_from(out):
-    """Return the KeplerOrbit of validated values ``out`` (None unset); refusals name it."""
-    if out.get('orbit_elements') is None:
-        return None
+    """
+    Return the orbit of validated values ``out``: a KeplerOrbit, a TleOrbit or None (unset).
+
+    Refusals (ConfigurationError) name the parameter: both orbits set, elements or
+    lines that do not make an orbit.
+    """
+    elements, tle = out.get('orbit_elements'), out.get('orbit_tle')
+    if elements is not None and tle is not None:
+        raise ConfigurationError('orbit_elements and orbit_tle are both set: set one (the '
+                                 'Kepler orbit or the TLE)')
     try:
-        return KeplerOrbit(out['orbit_elements'], out['orbit_mu'], out['planet_radius'])
+        if tle is not None:
+            return TleOrbit(*tle, epoch=out.get('epoch') or None)
+        if elements is not None:
+            return KeplerOrbit(elements, out['orbit_mu'], out['planet_radius'])
+    except ValueError as err:
+        raise ConfigurationError(str(err)) from None
+    return None
+
+
+def earth_rotation_angle(out, orbit):
+    """
+    Return the Earth's rotation angle at t = 0 (rad) of validated values ``out``.
+
+    ``earth_rotation_angle`` when set; else the Greenwich mean sidereal time of
+    ``epoch`` (or of a TLE orbit's epoch, its t = 0); else 0.
+    """
+    if out.get('earth_rotation_angle') is not None:
+        return out['earth_rotation_angle']
+    epoch = epoch_of(out, orbit)
+    return greenwich_mean_sidereal_time(julian_date(epoch)) if epoch else 0.0
+
+
+def field_from(out, orbit):
+    """
+    Return the magnetic field model of validated values ``out`` on ``orbit`` (None: none).
+
+    Refuses (ConfigurationError, naming the parameter) a field without an orbit
+    and coefficients that do not make one.
+    """
+    if out['magnetic_field_model'] == 'none':
+        return None
+    if orbit is None:
+        raise ConfigurationError(f'magnetic_field_model {out["magnetic_field_model"]} needs '
+                                 'an orbit, orbit_elements or orbit_tle (the field depends '
+                                 'on the position)')
+    try:
+        return DipoleField(out['magnetic_dipole_coefficients'],
+                           earth_rotation_angle(out, orbit), out['earth_rotation_rate'])
     except ValueError as err:
         raise ConfigurationError(str(err)) from None
 
@@ -94,19 +147,10 @@ def environment_from(out):
     magnetometer without what it needs.
     """
     orbit = orbit_from(out)
-    field = None
-    if out['magnetic_field_model'] == 'dipole':
-        if orbit is None:
-            raise ConfigurationError('magnetic_field_model dipole needs orbit_elements (the '
-                                     'field depends on the position)')
-        try:
-            field = DipoleField(out['magnetic_dipole_coefficients'],
-                                out['earth_rotation_angle'], out['earth_rotation_rate'])
-        except ValueError as err:
-            raise ConfigurationError(str(err)) from None
+    field = field_from(out, orbit)
     if out['gravity_gradient'] and orbit is None:
-        raise ConfigurationError('gravity_gradient needs orbit_elements (the torque depends on '
-                                 'the position)')
+        raise ConfigurationError('gravity_gradient needs an orbit, orbit_elements or orbit_tle '
+                                 '(the torque depends on the position)')
     for name in ('residual_dipole', 'magnetometer_bias'):
         if any(out[name]) and field is None:
             raise ConfigurationError(f'{name} needs magnetic_field_model dipole')

@@ -15,7 +15,7 @@ published one gyro sample later (the stamp is the state's, not the arrival's).
 A reading older than the estimate it would correct is dropped and counted.
 The Sun and field models need stamps in simulated time (the simulator's
 ``publish_clock: true``): the Sun moves with ``epoch`` plus the stamp, and the
-field with the Earth's rotation and the orbit (``orbit_elements``). The
+field with the Earth's rotation and the orbit (``orbit_elements`` or ``orbit_tle``). The
 magnetometer's bias is not estimated.
 
 Publishes ``attitude_estimate`` (geometry_msgs/PoseWithCovarianceStamped,
@@ -36,11 +36,10 @@ from rclpy.node import Node
 from rclpy.qos_overriding_options import QoSOverridingOptions
 from sensor_msgs.msg import Imu, MagneticField
 
-from .environment_parameters import environment_params, orbit_from
+from .environment_parameters import environment_params, field_from, orbit_from
 from .sensor_parameters import sensor_params, sun_from
 from .simulator_parameters import PARAMETERS as SIMULATOR
 from ..physics import quaternions as quat
-from ..physics.environment import DipoleField
 from ..physics.mekf import MEKF
 from ..ros import conversions as conv
 from ..ros.parameters import ConfigurationError, Param, ParameterTable
@@ -56,15 +55,7 @@ def _models(values, out):
     """Cross-check: the orbit, the Sun and the field the vector readings are compared with."""
     out['orbit'] = orbit_from(out)
     out['sun'] = sun_from(out, out['orbit'])
-    out['field'] = None
-    if out['magnetic_field_model'] == 'dipole':
-        if out['orbit'] is None:
-            raise ConfigurationError('magnetic_field_model dipole needs orbit_elements')
-        try:
-            out['field'] = DipoleField(out['magnetic_dipole_coefficients'],
-                                       out['earth_rotation_angle'], out['earth_rotation_rate'])
-        except ValueError as err:
-            raise ConfigurationError(str(err)) from None
+    out['field'] = field_from(out, out['orbit'])
     q = out['star_tracker_orientation']
     norm = math.sqrt(sum(c * c for c in q))
     if abs(norm - 1.0) > 1e-6:
@@ -89,7 +80,7 @@ PARAMETERS = ParameterTable([
     _simulator('gyro_turn_on_bias'),
     *sensor_params('epoch', 'sun_direction', 'star_tracker_noise', 'star_tracker_orientation',
                    'sun_sensor_noise'),
-    *environment_params('orbit_elements', 'orbit_mu', 'planet_radius', 'magnetic_field_model',
+    *environment_params('orbit_elements', 'orbit_tle', 'orbit_mu', 'planet_radius', 'magnetic_field_model',
                         'magnetic_dipole_coefficients', 'earth_rotation_angle',
                         'earth_rotation_rate', 'magnetometer_noise'),
     Param('initial_bias_sigma', 'double', 0.0, '0.0 rad/s',

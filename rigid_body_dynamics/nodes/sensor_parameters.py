@@ -67,16 +67,29 @@ def sensor_params(*names):
     return [SENSOR_PARAMS[n] for n in (names or SENSOR_PARAMS)]
 
 
+def epoch_of(out, orbit):
+    """
+    Return the UTC time of simulated time 0 (ISO 8601 text; '' = none) of values ``out``.
+
+    ``epoch`` when set; else a TLE orbit's own epoch (its t = 0).
+    """
+    if out.get('epoch'):
+        return out['epoch']
+    return getattr(orbit, 'start_text', '')
+
+
 def sun_from(out, orbit):
     """
     Return the Sun of validated values ``out`` (None without an epoch in an orbit).
 
-    With an orbit the Sun needs ``epoch``; without one it is ``sun_direction``.
+    With an orbit the Sun needs an epoch (:func:`epoch_of`); without one it is
+    ``sun_direction``.
     """
     try:
         if orbit is None:
             return Sun(fixed=out['sun_direction'])
-        return Sun(epoch=out['epoch']) if out['epoch'] else None
+        epoch = epoch_of(out, orbit)
+        return Sun(epoch=epoch) if epoch else None
     except ValueError as err:
         raise ConfigurationError(str(err)) from None
 
@@ -98,7 +111,8 @@ def sensors_from(out, disturbances):
         out['star_tracker_rate'] > 0.0 and out['star_tracker_sun_exclusion'] > 0.0)
     if needs_sun and disturbances.sun is None:
         raise ConfigurationError("the sun sensor and the star tracker's Sun exclusion need "
-                                 "epoch with orbit_elements (the Sun's direction on the orbit)")
+                                 "epoch with orbit_elements, or orbit_tle (the Sun's direction "
+                                 'on the orbit)')
     sensors = []
     try:
         if out['publish_imu']:

@@ -175,10 +175,8 @@ class AttitudeSimulator(Node):
         if env.active:
             self.get_logger().info(f'disturbances: {env}')
         if env.orbit is not None:
-            a, e, inc = env.orbit.elements[:3]
             self.get_logger().info(
-                f'orbit: a = {a:.6g} m, e = {e:g}, i = {inc:g} rad, period '
-                f'{env.orbit.period:.6g} s; magnetic field: '
+                f'orbit: {env.orbit.summary()}; magnetic field: '
                 f'{values["magnetic_field_model"]}'
                 + ('; magnetorquers on magnetorquer_cmd' if self.body.max_dipole else ''))
         if self.body.wheels is not None:

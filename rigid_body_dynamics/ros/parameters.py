@@ -61,6 +61,14 @@ def as_vector(name, value, size):
     return tuple(as_float(f'{name}[{i}]', v) for i, v in enumerate(items))
 
 
+def as_strings(name, value, size):
+    """Return ``value`` as a tuple of ``size`` strings, or raise ConfigurationError."""
+    if isinstance(value, str) or not isinstance(value, (list, tuple)) or len(value) != size \
+            or not all(isinstance(v, str) for v in value):
+        raise ConfigurationError(f'{name} must be a list of {size} strings, got {value!r}')
+    return tuple(value)
+
+
 def number_list(name):
     """Return a converter of a list of any length into a tuple of finite floats ('double[]')."""
     def convert(value):
@@ -93,7 +101,8 @@ class Param:
     """
     One node parameter: declaration, validation and its row in the manual from one place.
 
-    ``kind``: 'double', 'double[N]', 'double[3|6]', 'int', 'bool' or 'string'.
+    ``kind``: 'double', 'double[N]', 'double[3|6]', 'int', 'bool', 'string' or
+    'string[N]' (a list of N strings).
     ``default``: the value, or a callable of the node returning it (it may
     read parameters declared before it, e.g. the preset); None for an
     optional parameter that is unset.
@@ -124,7 +133,8 @@ class Param:
         # doubles take integers too (-p inertia:=[1,2,3]); an int stays strictly typed
         return descriptor(self.text, read_only=self.read_only, low=self.low, high=self.high,
                           constraints=constraints, integer=self.kind == 'int',
-                          dynamic_typing=self.kind.startswith('double'))
+                          dynamic_typing=self.kind.startswith('double')
+                          or self.default is None)
 
     def check(self, value):
         """Return the value converted, or raise ConfigurationError saying why."""
@@ -143,6 +153,8 @@ class Param:
             return value
         if self.kind.startswith('double['):
             return as_vector(self.name, value, int(self.kind[7:-1]))
+        if self.kind.startswith('string['):
+            return as_strings(self.name, value, int(self.kind[7:-1]))
         if self.kind == 'int':
             if isinstance(value, bool) or not isinstance(value, int):
                 raise ConfigurationError(f'{self.name} must be an integer, got {value!r}')

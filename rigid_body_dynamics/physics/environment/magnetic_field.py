@@ -10,7 +10,9 @@ with the Gauss coefficients of degree 1 (nT; B comes out in tesla here),
 R_ref = 6371.2 km the reference radius of the IGRF (International
 Geomagnetic Reference Field; Basilisk's magneticFieldCenteredDipole uses the
 same form). The Earth-fixed frame is the world frame turned about z by
-theta(t) = ``earth_rotation_angle`` + ``earth_rotation_rate`` t; since the
+theta(t) = theta0 + ``earth_rotation_rate`` t (theta0: ``earth_rotation_angle``,
+or the Greenwich mean sidereal time of the epoch, see
+:func:`~.tle_orbit.greenwich_mean_sidereal_time`); since the
 formula is the same in every frame, d is turned into the world frame and B is
 evaluated there. Defaults: IGRF-13 at epoch 2020.0 (g10 = -29404.8, g11 =
 -1450.9, h11 = 4652.5 nT) and Earth's sidereal rate 7.2921150e-5 rad/s.

@@ -91,6 +91,11 @@ class KeplerOrbit:
         """Return the orbital period 2 pi / n (s)."""
         return _TWO_PI / self.n
 
+    def summary(self):
+        """Return a line that says which orbit this is (for the node's log)."""
+        a, e, inc = self.elements[:3]
+        return f'Kepler: a = {a:.6g} m, e = {e:g}, i = {inc:g} rad, period {self.period:.6g} s'
+
     def eccentric_anomaly(self, t):
         """Return E (rad, in [0, 2 pi)) at time t (s): Kepler's equation solved to round-off."""
         m = math.fmod(self.m0 + self.n * t, _TWO_PI)
