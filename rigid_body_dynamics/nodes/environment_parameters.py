@@ -12,8 +12,8 @@ that names the parameter.
 from .sensor_parameters import epoch_of, sun_from
 from ..engine import Disturbances
 from ..physics.environment import (DipoleField, EARTH_RATE, greenwich_mean_sidereal_time,
-                                   IGRF13_2020, julian_date, KeplerOrbit, MU_EARTH, R_EARTH,
-                                   TleOrbit)
+                                   IgrfField, IGRF13_2020, julian_date, KeplerOrbit, MU_EARTH,
+                                   R_EARTH, TleOrbit, unix_time)
 from ..ros.parameters import ConfigurationError, Param
 
 _IGRF = [float(c) for c in IGRF13_2020]
@@ -41,10 +41,15 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
           'The gravity-gradient torque 3 mu / |r|^5 (r_B x I r_B) on the orbit (needs '
           'orbit_elements or orbit_tle), evaluated at every integrator stage.', read_only=True),
     Param('magnetic_field_model', 'string', 'none', '`none`',
-          "The planet's magnetic field: none, or dipole (the centred tilted dipole of degree "
-          '1; needs orbit_elements or orbit_tle). With a field the node takes '
-          'magnetorquer_cmd.',
-          read_only=True, choices=('dipole', 'none')),
+          "The planet's magnetic field (needs orbit_elements or orbit_tle): none; dipole, the "
+          'centred tilted dipole of magnetic_dipole_coefficients; or igrf, the IGRF-14 to '
+          'magnetic_field_degree at the epoch\'s date (the ppigrf library\'s coefficients; '
+          'needs an epoch, 1900-2030), interpolated along the orbit within 0.01 nT of the sum. With a '
+          'field the node takes magnetorquer_cmd.',
+          read_only=True, choices=('dipole', 'igrf', 'none')),
+    Param('magnetic_field_degree', 'int', 13, '13',
+          'The highest degree of the IGRF-14 sum (magnetic_field_model igrf); 1 is the tilted '
+          'dipole of the date.', low=1, high=13, read_only=True),
     Param('magnetic_dipole_coefficients', 'double[3]', _IGRF,
           '[-29404.8, -1450.9, 4652.5] nT (IGRF-13, 2020.0)',
           'Gauss coefficients [g10, g11, h11] (nT) of the dipole field, reference radius '
@@ -130,9 +135,19 @@ def field_from(out, orbit):
         raise ConfigurationError(f'magnetic_field_model {out["magnetic_field_model"]} needs '
                                  'an orbit, orbit_elements or orbit_tle (the field depends '
                                  'on the position)')
+    angle = earth_rotation_angle(out, orbit)
     try:
-        return DipoleField(out['magnetic_dipole_coefficients'],
-                           earth_rotation_angle(out, orbit), out['earth_rotation_rate'])
+        if out['magnetic_field_model'] == 'dipole':
+            return DipoleField(out['magnetic_dipole_coefficients'], angle,
+                               out['earth_rotation_rate'])
+        epoch = epoch_of(out, orbit)
+        if not epoch:
+            raise ConfigurationError('magnetic_field_model igrf needs epoch (the date of the '
+                                     "field's coefficients)")
+        return IgrfField(orbit, unix_time(epoch), out['magnetic_field_degree'], angle,
+                         out['earth_rotation_rate'])
+    except ConfigurationError:
+        raise
     except ValueError as err:
         raise ConfigurationError(str(err)) from None
 
@@ -153,9 +168,10 @@ def environment_from(out):
                                  '(the torque depends on the position)')
     for name in ('residual_dipole', 'magnetometer_bias'):
         if any(out[name]) and field is None:
-            raise ConfigurationError(f'{name} needs magnetic_field_model dipole')
+            raise ConfigurationError(f'{name} needs a field: magnetic_field_model dipole or igrf')
     if out['magnetometer_rate'] > 0.0 and field is None:
-        raise ConfigurationError('magnetometer_rate > 0 needs magnetic_field_model dipole')
+        raise ConfigurationError('magnetometer_rate > 0 needs a field: magnetic_field_model '
+                                 'dipole or igrf')
     if any(c < 0.0 for c in out['magnetorquer_max_dipole']):
         raise ConfigurationError('magnetorquer_max_dipole must be >= 0 per axis (0 = no limit), '
                                  f'got {list(out["magnetorquer_max_dipole"])}')

@@ -183,7 +183,7 @@ SIMULATOR = Interfaces('attitude_simulator', [
               'each axis clipped to `magnetorquer_max_dipole`; held and timed out like '
               '`torque_cmd`; torque m x B at every integrator stage. In lockstep a stamped one '
               'answers a tick as `torque_cmd` does (`lockstep_answer`).',
-              'if `magnetic_field_model` is dipole'),
+              'with a field (`magnetic_field_model` dipole or igrf)'),
     Interface('pub', 'odom', 'nav_msgs/msg/Odometry',
               '`world_frame` -> `body_frame`: orientation body -> world, twist.angular = omega '
               '(rad/s, body frame); with an orbit pose.position = r (m, world) and '
@@ -208,7 +208,7 @@ SIMULATOR = Interfaces('attitude_simulator', [
     Interface('pub', 'applied_dipole', 'geometry_msgs/msg/Vector3Stamped',
               'The magnetorquer dipole (A m^2, `body_frame`) held over the step that ended at '
               'the odom stamp, after the limits (zero after a timeout).',
-              'if `magnetic_field_model` is dipole'),
+              'with a field (`magnetic_field_model` dipole or igrf)'),
     Interface('pub', 'magnetic_field', 'sensor_msgs/msg/MagneticField',
               'The magnetometer at `magnetometer_rate`: the field (T, `body_frame`) plus '
               '`magnetometer_bias` and white noise; covariance noise^2 on the diagonal.',
@@ -364,8 +364,8 @@ ESTIMATOR = Interfaces('attitude_estimator', [
               'Sun directions (body frame) against the Sun of `epoch` / `sun_direction`; '
               'used when `sun_sensor_noise` > 0.'),
     Interface('sub', 'magnetic_field', 'sensor_msgs/msg/MagneticField',
-              'The field (body frame) against the dipole model on the orbit; used with '
-              '`magnetic_field_model` dipole and `magnetometer_noise` > 0.'),
+              'The field (body frame) against the field model on the orbit; used with '
+              '`magnetic_field_model` dipole or igrf and `magnetometer_noise` > 0.'),
     Interface('pub', 'attitude_estimate', 'geometry_msgs/msg/PoseWithCovarianceStamped',
               'The estimate at every gyro stamp (one gyro sample late): orientation in '
               '`world_frame`, its covariance about the world axes (rad^2); position not '

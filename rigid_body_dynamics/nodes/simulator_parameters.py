@@ -125,9 +125,9 @@ def _lockstep_answer(values, out):
     if answer and 'wheels' in answer and out['wheels'] is None:
         raise ConfigurationError(f'lockstep_answer {out["lockstep_answer"]} needs wheels '
                                  '(wheel_axes)')
-    if answer == ('dipole',) and out['magnetic_field_model'] != 'dipole':
+    if answer == ('dipole',) and out['magnetic_field_model'] == 'none':
         raise ConfigurationError('lockstep_answer magnetorquer_cmd needs magnetorquers '
-                                 '(magnetic_field_model dipole)')
+                                 '(magnetic_field_model dipole or igrf)')
     out['answer'] = answer
 
 

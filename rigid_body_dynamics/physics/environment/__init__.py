@@ -2,22 +2,25 @@
 The space environment (no ROS): the orbit, Earth's dipole field, and torque models.
 
 :mod:`.orbit` (two-body orbit, LVLH frame), :mod:`.tle_orbit` (a TLE's orbit by
-SGP4, the Greenwich mean sidereal time), :mod:`.magnetic_field` (the
+SGP4, the Greenwich mean sidereal time), :mod:`.igrf_field` (the IGRF-14 along
+the orbit), :mod:`.magnetic_field` (the
 centred tilted dipole), :mod:`.torque_models` (the torque-model protocol:
 gravity gradient, magnetic dipoles, magnetorquers) and :mod:`.space`
 (:class:`SpaceEnvironment`: what the integrators evaluate at every stage) and
 :mod:`.sun` (the Sun's direction and the Earth's shadow).
 """
 
+from .igrf_field import igrf_coefficients, igrf_fixed, IgrfField
 from .magnetic_field import DipoleField, EARTH_RATE, IGRF13_2020, R_REF
 from .orbit import circular_elements, KeplerOrbit, lvlh_axes, lvlh_quaternion, MU_EARTH, R_EARTH
 from .space import Disturbances, SpaceEnvironment, Surroundings
-from .sun import in_shadow, julian_date, Sun, sun_direction_almanac
+from .sun import in_shadow, julian_date, Sun, sun_direction_almanac, unix_time
 from .tle_orbit import greenwich_mean_sidereal_time, MU_WGS72, TleOrbit
 from .torque_models import GravityGradient, MagneticDipole, Magnetorquers
 
 __all__ = ['circular_elements', 'DipoleField', 'Disturbances', 'EARTH_RATE', 'GravityGradient',
-           'greenwich_mean_sidereal_time', 'IGRF13_2020', 'in_shadow', 'julian_date',
+           'greenwich_mean_sidereal_time', 'IGRF13_2020', 'igrf_coefficients', 'igrf_fixed',
+           'IgrfField', 'in_shadow', 'julian_date',
            'KeplerOrbit', 'lvlh_axes', 'lvlh_quaternion', 'MagneticDipole', 'Magnetorquers',
            'MU_EARTH', 'MU_WGS72', 'R_EARTH', 'R_REF', 'SpaceEnvironment', 'Sun',
-           'sun_direction_almanac', 'Surroundings', 'TleOrbit']
+           'sun_direction_almanac', 'Surroundings', 'TleOrbit', 'unix_time']

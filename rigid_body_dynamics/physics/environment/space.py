@@ -79,7 +79,7 @@ class SpaceEnvironment:
         if 'field' in needs:
             if field is None:
                 raise ValueError('a magnetic torque needs a magnetic field model '
-                                 '(magnetic_field_model dipole)')
+                                 '(magnetic_field_model dipole or igrf)')
             needs.add('position')
         if 'position' in needs and orbit is None:
             raise ValueError('the gravity gradient and the magnetic field need an orbit '
