@@ -5,7 +5,9 @@ The asymmetric body I = (2, 3, 1.2) kg m^2 tumbling at omega0 = (0.3, -0.5, 0.8)
 steps, 100 Hz publishing, real time: free (no orbit), on a 500 km circular orbit with
 nothing acting (the exact torque-free flow still serves), with the gravity gradient,
 and with the gravity gradient, the dipole field, a residual dipole and a magnetometer
-at 10 Hz (every stage evaluates the orbit, the field and the torques). CPU is the
+at 10 Hz (every stage evaluates the orbit, the field and the torques); the engine's step
+also with the IGRF-14 to degree 13 instead of the dipole (interpolated along the orbit), on
+the Kepler orbit and on the ISS's TLE (SGP4, epoch 2019-12-09T20:42:00Z). CPU is the
 simulator's share of one core over 8 s after 3 s of warm-up, each case three times,
 alternating. Then the engine's step alone (``BodySimulation.advance`` on a fake clock, the
 least of three runs of 20000 steps), free, under a constant torque, and in the same
@@ -25,11 +27,17 @@ from nodes import measure_cpu, Probe, sim
 from rigid_body_dynamics.engine import BodySimulation, Disturbances
 from rigid_body_dynamics.physics import Inertia
 from rigid_body_dynamics.physics.dynamics.gyrostat import Wheels
-from rigid_body_dynamics.physics.environment import DipoleField, KeplerOrbit, SpaceEnvironment
+from rigid_body_dynamics.physics.environment import (DipoleField, EARTH_RATE, IgrfField,
+                                                     KeplerOrbit, SpaceEnvironment, TleOrbit,
+                                                     unix_time)
 
 ROUNDS = 3
 BODY = ('inertia:=[2.0, 3.0, 1.2]', 'initial_angular_velocity:=[0.3, -0.5, 0.8]')
 ORBIT = ('orbit_elements:=[6878137.0, 0.0, 1.0, 0.3, 0.0, 0.0]',)
+#: The ISS (NORAD 25544) on 2019-12-09: the public TLE of the sgp4 library's README.
+ISS = ('1 25544U 98067A   19343.69339541  .00001764  00000-0  38792-4 0  9991',
+       '2 25544  51.6439 211.2001 0007417  17.6667  85.6398 15.50103472202482')
+EPOCH = '2019-12-09T20:42:00Z'
 
 
 def measure():
@@ -79,7 +87,14 @@ def engine_steps(steps=20000):
              'in orbit, gravity gradient': Disturbances(orbit=orbit, gravity_gradient=True),
              'gravity gradient, field, residual dipole': Disturbances(
                  orbit=orbit, field=DipoleField(), gravity_gradient=True,
-                 residual_dipole=(0.01, -0.02, 0.005))}
+                 residual_dipole=(0.01, -0.02, 0.005)),
+             'gravity gradient, IGRF-14 to degree 13, residual dipole': Disturbances(
+                 orbit=orbit, field=IgrfField(orbit, unix_time(EPOCH), 13, 0.0, EARTH_RATE),
+                 gravity_gradient=True, residual_dipole=(0.01, -0.02, 0.005))}
+    tle = TleOrbit(*ISS, epoch=EPOCH)
+    cases['the same on the ISS TLE (SGP4)'] = Disturbances(
+        orbit=tle, field=IgrfField(tle, unix_time(EPOCH), 13, 0.0, EARTH_RATE),
+        gravity_gradient=True, residual_dipole=(0.01, -0.02, 0.005))
     pyramid = [c / 3 ** 0.5 for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1)) for c in g]
     wheels = Wheels(pyramid, (0.01,) * 4, coulomb=(1e-4,) * 4, viscous=(1e-6,) * 4)
     lines = ['| engine step (1 ms, I = (2, 3, 1.2) kg m^2) | wheels | us per step, models in '

@@ -37,6 +37,7 @@ import math
 
 import numpy as np
 
+from ..dynamics.rk_kernels import compile_source
 from ...optional import MissingDependency, require
 
 #: The IGRF reference radius (m), the same as the dipole's.
@@ -154,6 +155,9 @@ class IgrfField:
         self._fit = np.linalg.inv(np.vander(nodes, order + 1, increasing=True))
         self._segments = {}
         igrf_coefficients(self.start, degree)          # refuses a date outside the model
+        self._world = compile_source(horner_source(order), f'<igrf horner {order}>', {
+            'segments': self._segments, 'build': self.segment, 'floor': math.floor,
+            'inverse_span': 1.0 / self.span})
 
     def _turn(self, t):
         theta = self.theta0 + self.rate * t
@@ -168,7 +172,10 @@ class IgrfField:
         return (c * bx - s * by, s * bx + c * by, bz)
 
     def segment(self, k):
-        """Return (middle s, half-width s, monomial coefficients (3, order + 1)) of segment k."""
+        """
+        Return segment k: (middle s, 1 / half-width 1/s, then per component x, y, z the
+        order + 1 monomial coefficients in x = (t - middle) / half-width, T, x^0 first).
+        """
         found = self._segments.get(k)
         if found is None:
             half = 0.5 * self.span
@@ -186,14 +193,36 @@ class IgrfField:
             coefficients = (self._fit @ world).T               # (3, order + 1), x^0 first
             if len(self._segments) > 16:
                 self._segments.clear()
-            found = self._segments[k] = (middle, half, tuple(map(tuple, coefficients[:, ::-1])))
+            found = self._segments[k] = (middle, 1.0 / half, *coefficients.ravel().tolist())
         return found
 
     def world(self, t, r=None):
         """Return B (T) in the world frame at time t (s) on the orbit, interpolated."""
-        middle, half, (cx, cy, cz) = self.segment(math.floor(t / self.span))
-        x = (t - middle) / half
-        bx = by = bz = 0.0
-        for a, b, c in zip(cx, cy, cz):              # Horner, the highest power first
-            bx, by, bz = bx * x + a, by * x + b, bz * x + c
-        return bx, by, bz
+        return self._world(t)
+
+
+def horner_source(order):
+    """
+    Source of ``world(t)``: B of the segment of t by Horner's rule, unrolled for ``order``.
+
+    Its names: ``segments`` (the dict of segments), ``build`` (makes a missing one),
+    ``floor`` and ``inverse_span`` (1 / segment length, 1/s).
+    """
+    names = [f'{c}{j}' for c in 'abc' for j in range(order + 1)]
+
+    def horner(c):
+        text = f'{c}{order}'
+        for j in range(order - 1, -1, -1):
+            text = f'{c}{j} + x * ({text})'
+        return text
+    return '\n'.join([
+        'def world(t):',
+        '    k = floor(t * inverse_span)',
+        '    found = segments.get(k)',
+        '    if found is None:',
+        '        found = build(k)',
+        f'    middle, inverse_half, {", ".join(names)} = found',
+        '    x = (t - middle) * inverse_half',
+        f'    return ({horner("a")},',
+        f'            {horner("b")},',
+        f'            {horner("c")})', ''])
