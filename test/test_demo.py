@@ -108,6 +108,40 @@ def test_demo_satellite_scene_in_lockstep_and_offline():
     assert found['satellite'] == found['--offline']
 
 
+def _text_blocks(page):
+    """Return the ```text blocks of doc/``page``."""
+    with open(os.path.join(os.path.dirname(__file__), '..', 'doc', page)) as f:
+        return re.findall(r'^```text\n(.*?)^```', f.read(), re.S | re.M)
+
+
+def test_demo_satellite_scene_on_a_tle_in_the_igrf_prints_what_the_tutorial_says():
+    """
+    The TLE tutorial's run, the ISS's TLE in IGRF-14: its lines, bit for bit (lockstep).
+
+    On the 51.6 deg orbit B-dot reaches 0.5 deg/s in 2891 s; the run depends on the
+    commands only, so the tutorial's text block is what it prints.
+    """
+    out = _demo('--preset', 'satellite', '--params-file',
+                os.path.join(os.path.dirname(__file__), '..', 'doc', 'examples',
+                             'satellite_tle.yaml'))
+    assert out.returncode == 0, out.stderr
+    printed = [line for line in out.stdout.splitlines() if not line.endswith('...')]
+    assert printed == _text_blocks('tutorials/satellite_tle.md')[0].splitlines(), printed
+
+
+def test_demo_refuses_a_params_file_it_cannot_take(tmp_path):
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text('just: text\n')
+    for args, reason in ((('--params-file', str(bad)), '--params-file goes with --preset'),
+                         (('--preset', 'satellite', '--params-file', str(bad)),
+                          'not a ROS parameters file'),
+                         (('--preset', 'satellite', '--params-file', str(tmp_path / 'no.yaml')),
+                          'cannot be read')):
+        out = _demo(*args)
+        assert out.returncode == 2 and reason in out.stderr, (args, out.stderr)
+        assert 'Traceback' not in out.stderr
+
+
 def test_the_manuals_satellite_yaml_is_the_demos_scene():
     """doc/examples/satellite.yaml says what the demo's satellite scene runs."""
     from rigid_body_dynamics.tools.demo import _satellite_parameters

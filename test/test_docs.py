@@ -274,6 +274,16 @@ def test_the_python_api_tour_prints_what_it_says():
     assert float(chandler) == pytest.approx(300.0, rel=1e-12)
 
 
+def test_the_igrf_comparison_prints_what_the_tle_tutorial_says():
+    """doc/examples/igrf_vs_dipole.py: its two lines are the tutorial's text block."""
+    run = subprocess.run([sys.executable, str(DOC / 'examples' / 'igrf_vs_dipole.py')],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    page = (DOC / 'tutorials' / 'satellite_tle.md').read_text()
+    blocks = re.findall(r'^```text\n(.*?)^```', page, re.S | re.M)
+    assert run.stdout == blocks[-1], (run.stdout, blocks[-1])
+
+
 def test_the_torque_model_example_runs_in_the_stages_and_balances_its_energy():
     """doc/examples/torque_model.py: its model in the stages, at round-off, dissipating."""
     run = subprocess.run([sys.executable, str(DOC / 'examples' / 'torque_model.py')],

@@ -65,8 +65,14 @@ SATELLITE_SCENE = {
 }
 
 
-def _satellite_parameters():
-    """Return the scene as node parameters: (all nodes, the simulator, the controller)."""
+def _satellite_parameters(params_file=None):
+    """
+    Return the scene as node parameters: (all nodes, the simulator, the controller).
+
+    ``params_file`` (a ROS parameters file, or None): its sections ``/**``,
+    ``/**/attitude_simulator`` and ``/**/attitude_controller`` replace the scene's
+    values name by name; an ``orbit_tle`` in it replaces the scene's orbit_elements.
+    """
     s = SATELLITE_SCENE
     shared = {'inertia': s['inertia'], 'orbit_elements': s['orbit_elements'],
               'gravity_gradient': True, 'magnetic_field_model': 'dipole',
@@ -77,33 +83,77 @@ def _satellite_parameters():
            'lockstep': True, 'control_period': s['control_period'],
            'lockstep_answer': 'magnetorquer_cmd'}
     ctl = {'mode': 'bdot', 'actuator': 'magnetorquers', 'bdot_gain': s['bdot_gain']}
+    if params_file is not None:
+        sections = _read_parameters_file(params_file)
+        for key, values in (('/**', shared), ('/**/attitude_simulator', sim),
+                            ('/**/attitude_controller', ctl)):
+            values.update(sections.get(key, {}))
+        if any('orbit_tle' in values for values in (shared, sim)) and \
+                'orbit_elements' not in sections.get('/**', {}):
+            del shared['orbit_elements']
     return shared, sim, ctl
 
 
-def satellite_lines(t, rates, dipoles, how):
-    """Lines about the satellite scene: when |omega| passed 5, 1 and 0.5 deg/s; rod saturation."""
-    from ..physics.environment import KeplerOrbit
-    s = SATELLITE_SCENE
-    orbit = KeplerOrbit(s['orbit_elements'])
+def _read_parameters_file(path):
+    """Return {section: parameters} of a ROS parameters file; ValueError says what is wrong."""
+    import yaml
+    try:
+        with open(path) as f:
+            data = yaml.safe_load(f)
+    except (OSError, yaml.YAMLError) as err:
+        raise ValueError(f'--params-file {path}: cannot be read ({err})') from None
+    if not isinstance(data, dict) or not all(
+            isinstance(v, dict) and isinstance(v.get('ros__parameters'), dict)
+            for v in data.values()):
+        raise ValueError(f'--params-file {path}: not a ROS parameters file (sections with '
+                         'ros__parameters)')
+    return {key: value['ros__parameters'] for key, value in data.items()}
+
+
+def _scene_text(shared, sim, ctl):
+    """Return (the orbit's words, its period s) of the scene's parameters, for its lines."""
+    from ..physics.environment import KeplerOrbit, TleOrbit
+    values = {**shared, **sim}
+    if 'orbit_tle' in values:
+        orbit = TleOrbit(*values['orbit_tle'], epoch=values.get('epoch') or None)
+        field = values.get('magnetic_field_model', 'dipole')
+        field = (f'IGRF-14 to degree {values.get("magnetic_field_degree", 13)}'
+                 if field == 'igrf' else field)
+        return (f'the orbit of the TLE of NORAD {orbit.satellite.satnum} ({orbit.period / 60:.1f} '
+                f'min, from {orbit.start_text[:19]}Z, field {field})', orbit.period)
+    orbit = KeplerOrbit(values['orbit_elements'])
+    return (f'a {(orbit.a - 6378137.0) / 1e3:.0f} km circular polar orbit ({orbit.period / 60:.1f} '
+            'min)', orbit.period)
+
+
+def satellite_lines(t, rates, dipoles, how, parameters=None):
+    """
+    Lines about the satellite scene: when |omega| passed 5, 1 and 0.5 deg/s; rod saturation.
+
+    ``parameters``: the scene's (all nodes, simulator, controller) values (default: the
+    built-in scene's).
+    """
+    shared, sim, ctl = parameters or _satellite_parameters()
+    orbit_text, period = _scene_text(shared, sim, ctl)
+    target = SATELLITE_SCENE['target_rate']
     deg = np.degrees(np.asarray(rates))
     below = {}
-    for level in (5.0, 1.0, math.degrees(s['target_rate'])):
+    for level in (5.0, 1.0, math.degrees(target)):
         hit = np.flatnonzero(deg <= level + 1e-12)
         below[level] = t[hit[0]] if hit.size else None
-    limit = s['magnetorquer_max_dipole'][0]
+    limit = shared['magnetorquer_max_dipole'][0]
     full = np.flatnonzero([max(abs(c) for c in m) >= limit * (1 - 1e-12) for m in dipoles])
     saturated = t[full[-1]] if full.size else 0.0
-    reached = below[math.degrees(s['target_rate'])]
-    return [f'{SATELLITE}: B-dot detumbles a 3U CubeSat (I = {tuple(s["inertia"])} kg m^2) '
-            f'from {deg[0]:.2f} deg/s in a {(orbit.a - 6378137.0) / 1e3:.0f} km circular polar '
-            f'orbit ({orbit.period / 60:.1f} min), k = {s["bdot_gain"]:g} A m^2 s/T every '
-            f'{s["control_period"]:g} s, {limit:g} A m^2 rods, {how}:',
+    reached = below[math.degrees(target)]
+    return [f'{SATELLITE}: B-dot detumbles a 3U CubeSat (I = {tuple(shared["inertia"])} kg m^2) '
+            f'from {deg[0]:.2f} deg/s in {orbit_text}, k = {ctl["bdot_gain"]:g} A m^2 s/T every '
+            f'{sim["control_period"]:g} s, {limit:g} A m^2 rods, {how}:',
             '  |omega| below ' + ', '.join(
                 f'{level:g} deg/s after {"never" if at is None else f"{at:.0f} s"}'
                 for level, at in below.items()),
-            f'  target {math.degrees(s["target_rate"]):g} deg/s reached '
+            f'  target {math.degrees(target):g} deg/s reached '
             + ('not within the run' if reached is None else
-               f'after {reached / orbit.period:.2f} orbit') +
+               f'after {reached / period:.2f} orbit') +
             f'; the rods were at their limit until {saturated:.0f} s']
 
 
@@ -134,8 +184,12 @@ def satellite_offline():
     return satellite_lines(np.array(run['times']), run['rates'], run['dipoles'], 'offline')
 
 
-def run_satellite():
-    """Run the satellite scene on the nodes: the simulator in lockstep and B-dot."""
+def run_satellite(params_file=None):
+    """
+    Run the satellite scene on the nodes: the simulator in lockstep and B-dot.
+
+    ``params_file``: values that replace the scene's (:func:`_satellite_parameters`).
+    """
     from geometry_msgs.msg import Vector3Stamped
     from nav_msgs.msg import Odometry
     from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -143,7 +197,9 @@ def run_satellite():
     from ..ros.client import interrupt, RosClient, start_node
     from ..ros.conversions import time_ns
     from ..ros.parameters import write_parameters_file
-    shared, sim_params, ctl_params = _satellite_parameters()
+    scene = shared, sim_params, ctl_params = _satellite_parameters(params_file)
+    _orbit_text, period = _scene_text(*scene)
+    limit = max(5700.0, 1.01 * period)
     params = write_parameters_file({'/**': shared, '/**/attitude_simulator': sim_params,
                                     '/**/attitude_controller': ctl_params})
     quiet = ['--log-level', 'warn', '--params-file', params]
@@ -173,8 +229,8 @@ def run_satellite():
 
         def done():
             stamps = sorted(rates)
-            return stamps[-1] >= 5700e9 or (rates[stamps[-1]] <= target and
-                                            stamps[-1] in dipoles)
+            return stamps[-1] >= limit * 1e9 or (rates[stamps[-1]] <= target and
+                                                 stamps[-1] in dipoles)
         client.spin_until(done, 300.0, 'the CubeSat to detumble')
     finally:
         client.close()
@@ -182,7 +238,7 @@ def run_satellite():
         os.unlink(params)
     stamps = [k for k in sorted(rates) if k in dipoles]
     return satellite_lines(np.array(stamps) * 1e-9, [rates[k] for k in stamps],
-                           [dipoles[k] for k in stamps], 'in lockstep') + [
+                           [dipoles[k] for k in stamps], 'in lockstep', scene) + [
         f'  stopped attitude_controller and attitude_simulator (exit codes '
         f'{", ".join(str(c) for c in codes)})']
 
@@ -515,7 +571,13 @@ def main(argv=None):
                         help='simulated seconds (--offline)')
     parser.add_argument('--dt', type=float, default=1e-3, help='step (s)')
     parser.add_argument('--offline', action='store_true', help='physics only, no ROS nodes')
+    parser.add_argument('--params-file', default=None, metavar='FILE',
+                        help=f'--preset {SATELLITE} only: a ROS parameters file whose values '
+                        'replace the scene\'s (e.g. orbit_tle, epoch, magnetic_field_model igrf)')
     args = parser.parse_args(argv)
+    if args.params_file is not None and (args.preset != SATELLITE or args.offline):
+        parser.error(f'--params-file goes with --preset {SATELLITE}, on the nodes (not '
+                     '--offline)')
     names = [args.preset] if args.preset else ['symmetric_top', 'tennis_racket', CLOSED_LOOP,
                                                WHEELS, SATELLITE]
     reservation = None if args.offline else _ros_environment()
@@ -530,7 +592,8 @@ def main(argv=None):
                 print('\n'.join(lines), flush=True)
                 continue
             if name == SATELLITE:
-                lines = satellite_offline() if args.offline else run_satellite()
+                lines = satellite_offline() if args.offline else run_satellite(
+                    args.params_file)
                 print('\n'.join(lines), flush=True)
                 continue
             if name == LIBRATION:

@@ -10,14 +10,14 @@ the TLEs' producers do.
 Frames and units. SGP4 gives the position and velocity in TEME, the frame of
 the true equator and the mean equinox of date. Here TEME *is* the world frame
 (no turn): z along the Earth's rotation axis, x towards the mean equinox of
-date. It turns so slowly (precession and nutation, under 0.2 arcsec a day) that
+date. It turns so slowly (precession and nutation, under 0.3 arcsec a day) that
 it is taken as inertial over a run. The Almanac's Sun of :mod:`.sun` is of date
 too (the two differ by the nutation in right ascension, under 0.005 deg, below
 that formula's 0.01 deg), and the Earth's rotation angle of an epoch is the
 Greenwich mean sidereal time (:func:`greenwich_mean_sidereal_time`), the angle
 that turns TEME into the Earth-fixed frame (Vallado, Fundamentals of
 Astrodynamics and Applications, 4th ed., section 3.7). Against J2000 / GCRF,
-TEME of 2026 is turned by the precession since 2000, about 0.36 deg.
+TEME of 2026 is turned by the precession since 2000, about 0.37 deg.
 Positions in m, velocities in m/s, time t in s from simulated time 0, which is
 ``epoch`` when given, else the TLE's own epoch.
 """
