@@ -37,6 +37,8 @@ PYTHON_KEYS = {
 NO_KEY = {
     'plotly': "the report's page; optional.require names it when missing",
     'allantools': "tests only: the reference for the report's Allan deviation (pip)",
+    'sgp4': 'orbit_tle only; optional.require names it when missing (apt python3-sgp4)',
+    'ppigrf': 'magnetic_field_model igrf only; optional.require names it when missing (pip)',
 }
 #: Declared, though no Python file imports them (and where they are used).
 NOT_IMPORTED = {

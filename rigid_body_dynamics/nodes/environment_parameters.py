@@ -12,7 +12,7 @@ that names the parameter.
 from .sensor_parameters import epoch_of, sun_from
 from ..engine import Disturbances
 from ..physics.environment import (DipoleField, EARTH_RATE, greenwich_mean_sidereal_time,
-                                   IgrfField, IGRF13_2020, julian_date, KeplerOrbit, MU_EARTH,
+                                   IGRF13_2020, IgrfField, julian_date, KeplerOrbit, MU_EARTH,
                                    R_EARTH, TleOrbit, unix_time)
 from ..ros.parameters import ConfigurationError, Param
 
@@ -28,8 +28,8 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
     Param('orbit_tle', 'string[2]', None, 'unset (no TLE)',
           'The two lines of a TLE (NORAD two-line element set), flown by SGP4 (the sgp4 '
           'library, WGS-72): the world frame is then TEME (true equator, mean equinox of '
-          'date), and simulated time 0 is epoch, or the TLE\'s epoch when epoch is unset. '
-          'Instead of orbit_elements (set one); orbit_mu is then WGS-72\'s 3.986008e14 '
+          "date), and simulated time 0 is epoch, or the TLE's epoch when epoch is unset. "
+          "Instead of orbit_elements (set one); orbit_mu is then WGS-72's 3.986008e14 "
           'm^3/s^2.', read_only=True),
     Param('orbit_mu', 'double', MU_EARTH, '3.986004418e14 m^3/s^2',
           "The planet's gravitational parameter mu (m^3/s^2).", low=1e-30, high=1e30,
@@ -43,9 +43,9 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
     Param('magnetic_field_model', 'string', 'none', '`none`',
           "The planet's magnetic field (needs orbit_elements or orbit_tle): none; dipole, the "
           'centred tilted dipole of magnetic_dipole_coefficients; or igrf, the IGRF-14 to '
-          'magnetic_field_degree at the epoch\'s date (the ppigrf library\'s coefficients; '
-          'needs an epoch, 1900-2030), interpolated along the orbit within 0.01 nT of the sum. With a '
-          'field the node takes magnetorquer_cmd.',
+          "magnetic_field_degree at the epoch's date (the ppigrf library's coefficients; "
+          'needs an epoch, 1900-2030), interpolated along the orbit within 0.01 nT of the '
+          'sum. With a field the node takes magnetorquer_cmd.',
           read_only=True, choices=('dipole', 'igrf', 'none')),
     Param('magnetic_field_degree', 'int', 13, '13',
           'The highest degree of the IGRF-14 sum (magnetic_field_model igrf); 1 is the tilted '
@@ -56,7 +56,7 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
           '6371.2 km.', read_only=True),
     Param('earth_rotation_angle', 'double', None, 'unset (from the epoch)',
           'Angle of the Earth-fixed frame about the world z axis at t = 0 (rad). Unset: the '
-          'Greenwich mean sidereal time (IAU 1982) of epoch (or of the TLE\'s epoch), 0.0 '
+          "Greenwich mean sidereal time (IAU 1982) of epoch (or of the TLE's epoch), 0.0 "
           'without either.', low=-1e6, high=1e6, read_only=True),
     Param('earth_rotation_rate', 'double', EARTH_RATE, '7.292115e-05 rad/s',
           "The planet's rotation rate about z (rad/s): the field turns with it.",

@@ -21,8 +21,8 @@ SENSOR_PARAMS = {p.name: p for p in (
           "taken as UTC): with an orbit the Sun is where the Astronomical Almanac's "
           'low-precision solar coordinates put it (about 0.01 deg, 1950-2050). Needed by the '
           "star tracker's Sun exclusion and the sun sensor when there is an orbit. It "
-          "is also the date of the IGRF field and, unless earth_rotation_angle is set, "
-          "turns the Earth by its Greenwich mean sidereal time.",
+          'is also the date of the IGRF field and, unless earth_rotation_angle is set, '
+          'turns the Earth by its Greenwich mean sidereal time.',
           read_only=True),
     Param('sun_direction', 'double[3]', [1.0, 0.0, 0.0], '[1, 0, 0]',
           'Unit vector to the Sun in the world frame when there is no orbit (fixed; no '

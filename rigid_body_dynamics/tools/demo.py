@@ -119,11 +119,13 @@ def _scene_text(shared, sim, ctl):
         field = values.get('magnetic_field_model', 'dipole')
         field = (f'IGRF-14 to degree {values.get("magnetic_field_degree", 13)}'
                  if field == 'igrf' else field)
-        return (f'the orbit of the TLE of NORAD {orbit.satellite.satnum} ({orbit.period / 60:.1f} '
-                f'min, from {orbit.start_text[:19]}Z, field {field})', orbit.period)
+        return (f'the orbit of the TLE of NORAD {orbit.satellite.satnum} '
+                f'({orbit.period / 60:.1f} min, from {orbit.start_text[:19]}Z, field {field})',
+                orbit.period)
     orbit = KeplerOrbit(values['orbit_elements'])
-    return (f'a {(orbit.a - 6378137.0) / 1e3:.0f} km circular polar orbit ({orbit.period / 60:.1f} '
-            'min)', orbit.period)
+    height = (orbit.a - 6378137.0) / 1e3
+    return (f'a {height:.0f} km circular polar orbit ({orbit.period / 60:.1f} min)',
+            orbit.period)
 
 
 def satellite_lines(t, rates, dipoles, how, parameters=None):
@@ -573,7 +575,7 @@ def main(argv=None):
     parser.add_argument('--offline', action='store_true', help='physics only, no ROS nodes')
     parser.add_argument('--params-file', default=None, metavar='FILE',
                         help=f'--preset {SATELLITE} only: a ROS parameters file whose values '
-                        'replace the scene\'s (e.g. orbit_tle, epoch, magnetic_field_model igrf)')
+                        "replace the scene's (e.g. orbit_tle, epoch, magnetic_field_model igrf)")
     args = parser.parse_args(argv)
     if args.params_file is not None and (args.preset != SATELLITE or args.offline):
         parser.error(f'--params-file goes with --preset {SATELLITE}, on the nodes (not '

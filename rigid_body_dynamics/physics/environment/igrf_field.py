@@ -1,6 +1,7 @@
 """
-Earth's magnetic field by the IGRF-14 (International Geomagnetic Reference Field, 14th
-generation), to degree 13, along an orbit (no ROS).
+Earth's magnetic field by the IGRF-14, to degree 13, along an orbit (no ROS).
+
+The International Geomagnetic Reference Field, 14th generation.
 
 The coefficients are the ``ppigrf`` library's (its ``IGRF14.shc``: the models of
 1900 to 2025 every five years, and 2030 from the secular variation), taken at
@@ -173,8 +174,10 @@ class IgrfField:
 
     def segment(self, k):
         """
-        Return segment k: (middle s, 1 / half-width 1/s, then per component x, y, z the
-        order + 1 monomial coefficients in x = (t - middle) / half-width, T, x^0 first).
+        Return segment k: (middle s, 1 / half-width 1/s, then the coefficients).
+
+        The coefficients: per component x, y, z the order + 1 monomial coefficients
+        in x = (t - middle) / half-width (T, x^0 first).
         """
         found = self._segments.get(k)
         if found is None:
