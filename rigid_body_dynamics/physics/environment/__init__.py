@@ -6,21 +6,24 @@ SGP4, the Greenwich mean sidereal time), :mod:`.igrf_field` (the IGRF-14 along
 the orbit), :mod:`.magnetic_field` (the
 centred tilted dipole), :mod:`.torque_models` (the torque-model protocol:
 gravity gradient, magnetic dipoles, magnetorquers) and :mod:`.space`
-(:class:`SpaceEnvironment`: what the integrators evaluate at every stage) and
-:mod:`.sun` (the Sun's direction and the Earth's shadow).
+(:class:`SpaceEnvironment`: what the integrators evaluate at every stage),
+:mod:`.sun` (the Sun's direction and the Earth's cylindrical shadow) and
+:mod:`.shadow` (the conical shadow with its penumbra).
 """
 
 from .igrf_field import igrf_coefficients, igrf_fixed, IgrfField
 from .magnetic_field import DipoleField, EARTH_RATE, IGRF13_2020, R_REF
 from .orbit import circular_elements, KeplerOrbit, lvlh_axes, lvlh_quaternion, MU_EARTH, R_EARTH
+from .shadow import conical_shadow_fraction, R_SUN
 from .space import Disturbances, SpaceEnvironment, Surroundings
 from .sun import in_shadow, julian_date, Sun, sun_direction_almanac, unix_time
 from .tle_orbit import greenwich_mean_sidereal_time, MU_WGS72, TleOrbit
 from .torque_models import GravityGradient, MagneticDipole, Magnetorquers
 
-__all__ = ['circular_elements', 'DipoleField', 'Disturbances', 'EARTH_RATE', 'GravityGradient',
+__all__ = ['circular_elements', 'conical_shadow_fraction', 'DipoleField', 'Disturbances',
+           'EARTH_RATE', 'GravityGradient',
            'greenwich_mean_sidereal_time', 'IGRF13_2020', 'igrf_coefficients', 'igrf_fixed',
            'IgrfField', 'in_shadow', 'julian_date',
            'KeplerOrbit', 'lvlh_axes', 'lvlh_quaternion', 'MagneticDipole', 'Magnetorquers',
-           'MU_EARTH', 'MU_WGS72', 'R_EARTH', 'R_REF', 'SpaceEnvironment', 'Sun',
+           'MU_EARTH', 'MU_WGS72', 'R_EARTH', 'R_REF', 'R_SUN', 'SpaceEnvironment', 'Sun',
            'sun_direction_almanac', 'Surroundings', 'TleOrbit', 'unix_time']

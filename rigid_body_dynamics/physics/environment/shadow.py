@@ -1,0 +1,61 @@
+"""
+The Earth's conical shadow with its penumbra: the fraction of the Sun's light a body receives.
+
+Montenbruck and Gill, Satellite Orbits (Springer, 2000), section 3.4.2. Seen
+from the body at r (m, world, from the planet's centre), the Sun's disc has the
+angular radius a = asin(R_sun / |r_sun - r|), the planet's b = asin(R / |r|),
+and their centres are c apart. Both are taken as flat discs of uniform
+brightness (no limb darkening, no atmosphere) and the fraction of the Sun's
+disc left uncovered is
+
+    c >= a + b              1                      (full sunlight)
+    c <= b - a              0                      (umbra)
+    c <= a - b              1 - b^2 / a^2          (annular: the planet inside the Sun's disc)
+    otherwise               1 - A / (pi a^2)       (penumbra),
+    x = (c^2 + a^2 - b^2) / (2 c),  y = sqrt(a^2 - x^2),
+    A = a^2 acos(x / a) + b^2 acos((c - x) / b) - c y   (the discs' overlap).
+
+For a low orbit the penumbra lasts seconds at each shadow crossing (8.2 s on a
+400 km circular orbit with the Sun in its plane, longer where the orbit crosses
+the shadow's edge at a slant), which the cylindrical shadow of
+:func:`.sun.in_shadow` (1 or 0) cannot show. Not yet used by the sensors: the
+sun sensor still reads the cylinder.
+"""
+
+import math
+
+#: The Sun's nominal radius (m; IAU 2015 Resolution B3).
+R_SUN = 6.957e8
+
+
+def conical_shadow_fraction(r, sun_position, planet_radius, sun_radius=R_SUN):
+    """
+    Return the fraction of the Sun's disc seen from ``r`` (0 = umbra, 1 = full sunlight).
+
+    ``r`` (m, world) is the body's position from the planet's centre,
+    ``sun_position`` (m, world) the Sun's, ``planet_radius`` and ``sun_radius``
+    (m) their radii. The Montenbruck-Gill flat-disc overlap (module docstring).
+    Refuses (ValueError) a body inside the planet or the Sun.
+    """
+    rx, ry, rz = r
+    dx, dy, dz = sun_position[0] - rx, sun_position[1] - ry, sun_position[2] - rz
+    body = math.sqrt(rx * rx + ry * ry + rz * rz)
+    sun = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if not (body > planet_radius and sun > sun_radius):
+        raise ValueError(f'a shadow needs a body outside the planet and the Sun: '
+                         f'|r| = {body:g} m, the Sun {sun:g} m away')
+    a = math.asin(sun_radius / sun)
+    b = math.asin(planet_radius / body)
+    cos_c = -(rx * dx + ry * dy + rz * dz) / (body * sun)
+    c = math.acos(max(-1.0, min(1.0, cos_c)))
+    if c >= a + b:
+        return 1.0
+    if c <= b - a:
+        return 0.0
+    if c <= a - b:
+        return 1.0 - (b * b) / (a * a)
+    x = (c * c + a * a - b * b) / (2.0 * c)
+    y = math.sqrt(max(0.0, a * a - x * x))
+    overlap = (a * a * math.acos(max(-1.0, min(1.0, x / a)))
+               + b * b * math.acos(max(-1.0, min(1.0, (c - x) / b))) - c * y)
+    return min(1.0, max(0.0, 1.0 - overlap / (math.pi * a * a)))
