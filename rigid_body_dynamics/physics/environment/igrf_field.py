@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from ..dynamics.rk_kernels import compile_source
+from .chebyshev import ChebyshevSegments
 from ...optional import MissingDependency, require
 
 #: The IGRF reference radius (m), the same as the dipole's.
@@ -148,17 +148,11 @@ class IgrfField:
                 raise ValueError(f'{name} must be finite, got {value!r}')
         self.orbit, self.start, self.degree = orbit, float(start), degree
         self.theta0, self.rate = float(rotation_angle), float(rotation_rate)
-        self.span = orbit.period / segments            # s of one segment
-        self.order = order
-        nodes = np.cos(math.pi * (np.arange(order + 1) + 0.5) / (order + 1))
-        self._nodes = nodes
-        # the monomials in x of the Chebyshev polynomials at the nodes: fit = solve
-        self._fit = np.linalg.inv(np.vander(nodes, order + 1, increasing=True))
-        self._segments = {}
         igrf_coefficients(self.start, degree)          # refuses a date outside the model
-        self._world = compile_source(horner_source(order), f'<igrf horner {order}>', {
-            'segments': self._segments, 'build': self.segment, 'floor': math.floor,
-            'inverse_span': 1.0 / self.span})
+        self.interpolant = ChebyshevSegments(self._sample, orbit.period / segments, order,
+                                             name='igrf')
+        self.span, self.order = self.interpolant.span, order
+        self.segment, self.world_at = self.interpolant.segment, self.interpolant.value
 
     def _turn(self, t):
         theta = self.theta0 + self.rate * t
@@ -172,60 +166,17 @@ class IgrfField:
         bx, by, bz = igrf_fixed([(c * x + s * y, -s * x + c * y, z)], keys, g, h)[0] * 1e-9
         return (c * bx - s * by, s * bx + c * by, bz)
 
-    def segment(self, k):
-        """
-        Return segment k: (middle s, 1 / half-width 1/s, then the coefficients).
-
-        The coefficients: per component x, y, z the order + 1 monomial coefficients
-        in x = (t - middle) / half-width (T, x^0 first).
-        """
-        found = self._segments.get(k)
-        if found is None:
-            half = 0.5 * self.span
-            middle = (k + 0.5) * self.span
-            times = middle + half * self._nodes
-            r = np.array([self.orbit.position(t) for t in times])
-            theta = self.theta0 + self.rate * times
-            c, s = np.cos(theta), np.sin(theta)
-            fixed = np.column_stack((c * r[:, 0] + s * r[:, 1], -s * r[:, 0] + c * r[:, 1],
-                                     r[:, 2]))
-            keys, g, h = igrf_coefficients(self.start + middle, self.degree)
-            b = igrf_fixed(fixed, keys, g, h) * 1e-9
-            world = np.column_stack((c * b[:, 0] - s * b[:, 1], s * b[:, 0] + c * b[:, 1],
-                                     b[:, 2]))
-            coefficients = (self._fit @ world).T               # (3, order + 1), x^0 first
-            if len(self._segments) > 16:
-                self._segments.clear()
-            found = self._segments[k] = (middle, 1.0 / half, *coefficients.ravel().tolist())
-        return found
+    def _sample(self, middle, times):
+        """Return B (T, world frame, (N, 3)) on the orbit at ``times`` (s), IGRF of ``middle``."""
+        r = np.array([self.orbit.position(t) for t in times])
+        theta = self.theta0 + self.rate * times
+        c, s = np.cos(theta), np.sin(theta)
+        fixed = np.column_stack((c * r[:, 0] + s * r[:, 1], -s * r[:, 0] + c * r[:, 1], r[:, 2]))
+        keys, g, h = igrf_coefficients(self.start + middle, self.degree)
+        b = igrf_fixed(fixed, keys, g, h) * 1e-9
+        return np.column_stack((c * b[:, 0] - s * b[:, 1], s * b[:, 0] + c * b[:, 1], b[:, 2]))
 
     def world(self, t, r=None):
         """Return B (T) in the world frame at time t (s) on the orbit, interpolated."""
-        return self._world(t)
+        return self.world_at(t)
 
-
-def horner_source(order):
-    """
-    Source of ``world(t)``: B of the segment of t by Horner's rule, unrolled for ``order``.
-
-    Its names: ``segments`` (the dict of segments), ``build`` (makes a missing one),
-    ``floor`` and ``inverse_span`` (1 / segment length, 1/s).
-    """
-    names = [f'{c}{j}' for c in 'abc' for j in range(order + 1)]
-
-    def horner(c):
-        text = f'{c}{order}'
-        for j in range(order - 1, -1, -1):
-            text = f'{c}{j} + x * ({text})'
-        return text
-    return '\n'.join([
-        'def world(t):',
-        '    k = floor(t * inverse_span)',
-        '    found = segments.get(k)',
-        '    if found is None:',
-        '        found = build(k)',
-        f'    middle, inverse_half, {", ".join(names)} = found',
-        '    x = (t - middle) * inverse_half',
-        f'    return ({horner("a")},',
-        f'            {horner("b")},',
-        f'            {horner("c")})', ''])
