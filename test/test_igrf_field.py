@@ -74,7 +74,8 @@ def test_the_interpolant_along_the_orbit_is_within_0_003_nt(rng, elements):
 
 
 def test_degree_1_is_the_dipole_of_the_same_coefficients(rng):
-    """The sum to degree 1 = DipoleField of (g10, g11, h11) at the date, to round-off of |B|.
+    """
+    The sum to degree 1 = DipoleField of (g10, g11, h11) at the date, to round-off of |B|.
 
     The two sum the same three terms in different orders: measured 4.5e-16 to 1.0e-15 of
     |B| (numpy 2.4 / 1.26), so the bound is 20 ulps (4.4e-15), not a knife edge at 1e-15.

@@ -179,4 +179,3 @@ class IgrfField:
     def world(self, t, r=None):
         """Return B (T) in the world frame at time t (s) on the orbit, interpolated."""
         return self.world_at(t)
-
