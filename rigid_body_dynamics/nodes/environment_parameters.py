@@ -13,7 +13,7 @@ from .sensor_parameters import epoch_of, sun_from
 from ..engine import Disturbances
 from ..physics.environment import (DipoleField, EARTH_RATE, greenwich_mean_sidereal_time,
                                    IGRF13_2020, IgrfField, julian_date, KeplerOrbit, MU_EARTH,
-                                   R_EARTH, TleOrbit, unix_time)
+                                   R_EARTH, TleOrbit, unix_time, ZonalOrbit)
 from ..ros.parameters import ConfigurationError, Param
 
 _IGRF = [float(c) for c in IGRF13_2020]
@@ -23,7 +23,8 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
     Param('orbit_elements', 'double[6]', None, 'unset (no orbit)',
           'Two-body orbit [a (m), e, i, RAAN, argument of perigee, true anomaly at t = 0 '
           "(rad)] in the world frame (inertial, z the planet's rotation axis), solved from "
-          "Kepler's equation at every step; 0 <= e < 1 and the perigee above planet_radius. "
+          "Kepler's equation at every step (or integrated under J2..J6: orbit_zonal_degree); "
+          '0 <= e < 1 and the perigee above planet_radius. '
           'Unset = no orbit (a free body, unless orbit_tle is set).', read_only=True),
     Param('orbit_tle', 'string[2]', None, 'unset (no TLE)',
           'The two lines of a TLE (NORAD two-line element set), flown by SGP4 (the sgp4 '
@@ -31,6 +32,12 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
           "date), and simulated time 0 is epoch, or the TLE's epoch when epoch is unset. "
           "Instead of orbit_elements (set one); orbit_mu is then WGS-72's 3.986008e14 "
           'm^3/s^2.', read_only=True),
+    Param('orbit_zonal_degree', 'int', 0, '0 (Kepler)',
+          'With orbit_elements: 0 flies the two-body Kepler orbit; 2..6 integrates the orbit '
+          "under the planet's zonal harmonics J2 to J<degree> (EGM2008's, reference radius "
+          '6378136.3 m; DOP853 at rtol 1e-13), the elements then osculating at t = 0, the '
+          'world frame the same. Not with orbit_tle (SGP4 has its own J2 to J4).',
+          low=0, high=6, read_only=True),
     Param('orbit_mu', 'double', MU_EARTH, '3.986004418e14 m^3/s^2',
           "The planet's gravitational parameter mu (m^3/s^2).", low=1e-30, high=1e30,
           read_only=True),
@@ -90,18 +97,28 @@ def environment_params(*names):
 
 def orbit_from(out):
     """
-    Return the orbit of validated values ``out``: a KeplerOrbit, a TleOrbit or None (unset).
+    Return the orbit of validated values ``out``: Kepler, zonal, TLE or None (unset).
 
-    Refusals (ConfigurationError) name the parameter: both orbits set, elements or
-    lines that do not make an orbit.
+    A :class:`KeplerOrbit`, a :class:`ZonalOrbit` (``orbit_zonal_degree`` > 0) or
+    a :class:`TleOrbit`. Refusals (ConfigurationError) name the parameter: both
+    orbits set, a zonal degree without elements or with a TLE, elements or lines
+    that do not make an orbit.
     """
     elements, tle = out.get('orbit_elements'), out.get('orbit_tle')
+    degree = out.get('orbit_zonal_degree') or 0
     if elements is not None and tle is not None:
         raise ConfigurationError('orbit_elements and orbit_tle are both set: set one (the '
                                  'Kepler orbit or the TLE)')
+    if degree and elements is None:
+        raise ConfigurationError(f'orbit_zonal_degree {degree} needs orbit_elements (the '
+                                 'osculating elements at t = 0)' + (
+                                     '; SGP4 flies orbit_tle with its own J2 to J4'
+                                     if tle is not None else ''))
     try:
         if tle is not None:
             return TleOrbit(*tle, epoch=out.get('epoch') or None)
+        if degree:
+            return ZonalOrbit(elements, degree, out['orbit_mu'], out['planet_radius'])
         if elements is not None:
             return KeplerOrbit(elements, out['orbit_mu'], out['planet_radius'])
     except ValueError as err:

@@ -8,7 +8,9 @@ centred tilted dipole), :mod:`.torque_models` (the torque-model protocol:
 gravity gradient, magnetic dipoles, magnetorquers) and :mod:`.space`
 (:class:`SpaceEnvironment`: what the integrators evaluate at every stage),
 :mod:`.sun` (the Sun's direction and the Earth's cylindrical shadow) and
-:mod:`.shadow` (the conical shadow with its penumbra).
+:mod:`.shadow` (the conical shadow with its penumbra); :mod:`.zonal_orbit` (the
+orbit integrated under J2..J6) and :mod:`.chebyshev` (the interpolants both it and
+the IGRF field use along the orbit).
 """
 
 from .igrf_field import igrf_coefficients, igrf_fixed, IgrfField
@@ -19,6 +21,7 @@ from .space import Disturbances, SpaceEnvironment, Surroundings
 from .sun import in_shadow, julian_date, Sun, sun_direction_almanac, unix_time
 from .tle_orbit import greenwich_mean_sidereal_time, MU_WGS72, TleOrbit
 from .torque_models import GravityGradient, MagneticDipole, Magnetorquers
+from .zonal_orbit import ZonalOrbit
 
 __all__ = ['circular_elements', 'conical_shadow_fraction', 'DipoleField', 'Disturbances',
            'EARTH_RATE', 'GravityGradient',
@@ -26,4 +29,5 @@ __all__ = ['circular_elements', 'conical_shadow_fraction', 'DipoleField', 'Distu
            'IgrfField', 'in_shadow', 'julian_date',
            'KeplerOrbit', 'lvlh_axes', 'lvlh_quaternion', 'MagneticDipole', 'Magnetorquers',
            'MU_EARTH', 'MU_WGS72', 'R_EARTH', 'R_REF', 'R_SUN', 'SpaceEnvironment', 'Sun',
-           'sun_direction_almanac', 'Surroundings', 'TleOrbit', 'unix_time']
+           'sun_direction_almanac', 'Surroundings', 'TleOrbit', 'unix_time',
+           'ZonalOrbit']

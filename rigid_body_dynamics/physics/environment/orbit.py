@@ -2,8 +2,9 @@
 A two-body (Kepler) orbit, exact at any time, and its local-vertical local-horizontal frame.
 
 Frames and units. The world frame is inertial with z along the planet's rotation
-axis (ECI, J2000-like); positions in m, velocities in m/s, angles in rad, time
-in s from simulated time 0.
+axis (which equator and equinox is the user's: with a TLE it is TEME of date,
+:mod:`.tle_orbit`); positions in m, velocities in m/s, angles in rad, time in s
+from simulated time 0.
 
 Elements ``[a, e, i, RAAN, argp, nu0]``: semi-major axis a (m), eccentricity e
 (0 <= e < 1), inclination i, right ascension of the ascending node RAAN,
