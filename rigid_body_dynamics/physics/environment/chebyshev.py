@@ -24,8 +24,8 @@ class ChebyshevSegments:
 
     ``sample`` gets the segment's middle (s) and its order + 1 Chebyshev nodes
     ``times`` (s, an array) and returns the function's three components there (any
-    unit: the interpolant has the same). Calling the object with t (s) returns the
-    interpolant at t, a 3-tuple. ``keep``: segments kept before the cache is emptied.
+    unit: the interpolant has the same). :attr:`value` (t s) is the interpolant at t,
+    a 3-tuple (compiled: what a stage calls). ``keep``: segments kept before the cache is emptied.
     """
 
     def __init__(self, sample, span, order, keep=16, name='chebyshev'):
@@ -39,10 +39,6 @@ class ChebyshevSegments:
         self.value = compile_source(horner_source(order), f'<{name} horner {order}>', {
             'segments': self._segments, 'build': self.segment, 'floor': math.floor,
             'inverse_span': 1.0 / self.span})
-
-    def __call__(self, t):
-        """Return the interpolant at time t (s), a 3-tuple."""
-        return self.value(t)
 
     def segment(self, k):
         """

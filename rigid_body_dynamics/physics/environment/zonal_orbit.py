@@ -129,7 +129,6 @@ class ZonalOrbit:
         r0, v0 = kepler.state(0.0)
         self._starts = {0: np.array(r0 + v0)}        # chunk k's state at k * period
         self._chunk = (None, None)                   # (k, its dense solution): the last one
-        self._segments = segments
         self._position = ChebyshevSegments(lambda m, t: self._sample(t)[:, :3],
                                            self.period / segments, order, name='zonal r')
         self._velocity = ChebyshevSegments(lambda m, t: self._sample(t)[:, 3:],
