@@ -86,11 +86,15 @@ def test_a_node_that_does_not_stop_says_where_it_is_before_it_is_killed(
     harness to a node; the stacks name the integration thread and the executor.
     """
     from nav_msgs.msg import Odometry
+    from rcl_interfaces.srv import ListParameters
     from rigid_body_dynamics.ros.client import dump_and_kill
     monkeypatch.setenv('FASTDDS_BUILTIN_TRANSPORTS', 'UDPv4')     # SIGKILL: no shm left
     sim = launch('rigid_body_dynamics.nodes.simulator', name='sim')
     probe.subscribe(Odometry, '/odom')
-    probe.wait_for('/odom')                 # running: its threads exist
+    # Running, both threads: the first odom is published from __init__ (the initial state),
+    # the second by the integration thread, and a parameter service answers from the executor.
+    probe.wait_for('/odom', count=2)
+    probe.call(ListParameters, '/attitude_simulator/list_parameters', ListParameters.Request())
     sim.handled = True                  # killed on purpose
     assert dump_and_kill(sim.proc) == -signal.SIGKILL
     output = sim.output()

@@ -220,8 +220,10 @@ def test_an_orbit_under_j2_to_j6_over_topics(launch, probe):
                   '-p', 'orbit_zonal_degree:=6', '-p', 'integration_rate:=10.0',
                   '-p', 'publish_rate:=1.0', '-p', 'real_time_factor:=200.0', name='zonal')
     odom = probe.subscribe(Odometry, 'odom')
-    probe.spin_until(lambda: odom and time_ns(odom[-1].header.stamp) >= 400e9, 30.0,
-                     'odom stamped 400 s')
+    # At 200 times real time the probe may match the publisher a few hundred seconds of
+    # simulated time late (seen in CI beside a CPU hog): what is compared is what arrived.
+    probe.spin_until(lambda: len(odom) >= 100 and time_ns(odom[-1].header.stamp) >= 400e9,
+                     30.0, '100 odom messages, the newest stamped 400 s or later')
     stamps = np.array([time_ns(m.header.stamp) * 1e-9 for m in odom])
     got = np.array([[m.pose.pose.position.x, m.pose.pose.position.y, m.pose.pose.position.z]
                     for m in odom])
