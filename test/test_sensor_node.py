@@ -145,6 +145,8 @@ def test_star_tracker_and_sun_sensor_over_topics(launch, probe):
      'need epoch with orbit_elements'),
     (('-p', f'orbit_elements:={list(ELEMENTS)}', '-p', 'epoch:=yesterday'), 'epoch must be'),
     (('-p', 'sun_direction:=[0.0, 0.0, 0.0]'), 'sun_direction must be'),
+    (('-p', 'shadow_model:=cone'), 'shadow_model must be one of cylindrical, conical'),
+    (('-p', 'sun_sensor_min_light:=1.5'), 'sun_sensor_min_light'),
 ])
 def test_bad_sensor_parameters_are_refused_at_start_naming_them(launch, args, reason):
     proc = launch(SIM, *args, name='bad_sensor')

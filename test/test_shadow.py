@@ -10,17 +10,27 @@ is smaller than the Sun (the annular case). Across the low orbit's penumbra the
 closed form and the integration differ by 5.8e-9 at most (the planet's disc,
 1.2 rad across, against the Sun's 0.005: the chords' kinks are sharp for quad),
 in the annular case by 6.3e-13.
+
+The sun sensor in the conical shadow is held to the cones' own geometry: the
+umbra and penumbra cones tangent to the Sun and the Earth, crossed by a circular
+orbit, found by brentq (a reference that shares no code with the disc overlap).
 """
 
 import math
 
 import numpy as np
 import pytest
-from rigid_body_dynamics.physics.environment import R_EARTH
+from rigid_body_dynamics.engine import BodySimulation, Disturbances
+from rigid_body_dynamics.physics import Inertia
+from rigid_body_dynamics.physics.environment import (circular_elements, julian_date, KeplerOrbit,
+                                                     R_EARTH, Sun)
 from rigid_body_dynamics.physics.environment.shadow import conical_shadow_fraction, R_SUN
+from rigid_body_dynamics.physics.environment.sun import sun_distance_almanac
+from rigid_body_dynamics.physics.sensors import Sky, SunSensor
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
+#: The astronomical unit (m; IAU 2012 Resolution B2), written here apart from the package's.
 AU = 149597870700.0
 
 
@@ -109,3 +119,95 @@ def test_the_fraction_rises_monotonically_across_the_edge_in_about_eight_seconds
 def test_a_body_inside_the_planet_is_refused():
     with pytest.raises(ValueError, match='outside the planet'):
         conical_shadow_fraction((1e6, 0.0, 0.0), (AU, 0.0, 0.0), R_EARTH)
+
+
+def test_the_suns_distance_at_the_2025_perihelion_and_aphelion():
+    """
+    The almanac's distance against the 2025 apsides: 147 103 686 km and 152 087 738 km.
+
+    Perihelion 2025-01-04 13:28 UTC, aphelion 2025-07-03 19:55 UTC (the Earth's centre,
+    as published from JPL's ephemeris). Delivered 3.5e-5 and 6.2e-5 au; the Moon moves the
+    Earth's centre up to 3e-5 au about the barycentre the formula follows.
+    """
+    for when, km in (('2025-01-04T13:28:00Z', 147_103_686.0),
+                     ('2025-07-03T19:55:00Z', 152_087_738.0)):
+        assert abs(sun_distance_almanac(julian_date(when)) - km * 1e3) < 1e-4 * AU, when
+    position = Sun('2025-07-03T00:00:00Z').position(19.0 * 3600.0 + 55.0 * 60.0)
+    assert abs(math.dist(position, (0.0, 0.0, 0.0)) - 152_087_738e3) < 1e-4 * AU
+    assert Sun(fixed=(0.0, 0.0, 2.0)).position(5.0) == (0.0, 0.0, AU)
+
+
+def _cone_crossings(radius, mu):
+    """
+    Return when a circular orbit in the Sun's plane meets the cones (s from the cylinder's edge).
+
+    The Sun 1 au along +x, the body at angle u from +x: the penumbra's cone (internal
+    tangents, half-angle asin((R_sun + R) / D), vertex R / sin of it towards the Sun) and the
+    umbra's (external tangents, asin((R_sun - R) / D), vertex behind the Earth).
+    Returns (penumbra entry, umbra entry); the exit mirrors them.
+    """
+    def outside(u, half_angle, apex):
+        behind = -radius * math.cos(u)                     # distance behind the Earth
+        cone = abs(behind - apex) * math.tan(half_angle)   # apex: behind (> 0) or sunwards
+        return abs(radius * math.sin(u)) - cone
+    penumbra = math.asin((R_SUN + R_EARTH) / AU)
+    umbra = math.asin((R_SUN - R_EARTH) / AU)
+    edge = math.pi - math.asin(R_EARTH / radius)
+    n = math.sqrt(mu / radius ** 3)
+    u_p = brentq(outside, edge - 0.05, edge, args=(penumbra, -R_EARTH / math.sin(penumbra)),
+                 xtol=1e-15)
+    u_u = brentq(outside, edge, edge + 0.05, args=(umbra, R_EARTH / math.sin(umbra)),
+                 xtol=1e-15)
+    return (u_p - edge) / n, (u_u - edge) / n
+
+
+@pytest.mark.parametrize('min_light, model',
+                         [(1.0, 'conical'), (1e-12, 'conical'), (0.5, 'cylindrical')])
+def test_the_sun_sensor_reads_while_enough_of_the_sun_shows(min_light, model):
+    """
+    shadow_model conical: the sun sensor stops reading where the cones say, at every tick.
+
+    A 400 km circular orbit with the Sun in its plane, readings at 10 Hz over the whole
+    eclipse. With min_light 1 the last reading before the shadow and the first after it
+    bracket the penumbra's cone (4.15 s before the cylinder's edge; the penumbra lasts
+    8.22 s), with min_light 1e-12 the umbra's; the cylinder at its own edge. Each missing
+    tick is counted as an eclipse.
+    """
+    radius = R_EARTH + 400e3
+    orbit = KeplerOrbit(circular_elements(400e3))
+    edge = (math.pi - math.asin(R_EARTH / radius)) / math.sqrt(orbit.mu / radius ** 3)
+    start = edge - 20.0                                    # the body's first tick
+    elements = circular_elements(400e3, anomaly=math.sqrt(orbit.mu / radius ** 3) * start)
+    sun = Sun(fixed=(1.0, 0.0, 0.0))
+    body = BodySimulation(Inertia((1.0, 2.0, 3.0)), 'exact', 10.0,
+                          ((0.0, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0)), publish_every=10,
+                          sensors=[SunSensor(10.0, min_light=min_light)], seed=1,
+                          disturbances=Disturbances(orbit=KeplerOrbit(elements), sun=sun,
+                                                    shadow_model=model))
+    out = []
+    eclipse = 2.0 * math.asin(R_EARTH / radius) * math.sqrt(radius ** 3 / orbit.mu)
+    with body.lock:
+        for _ in range(int((eclipse + 40.0) * 10.0)):
+            body.advance(0, out)
+    read = np.array([s.stamp_ns for s in out if getattr(s, 'sensor', None) == 'sun_sensor'])
+    read = read * 1e-9 + start
+    ticks = start + 0.1 * np.arange(1, int((eclipse + 40.0) * 10.0) + 1)
+    gap = np.diff(read).argmax()
+    entry, leave = read[gap] - edge, read[gap + 1] - edge - eclipse  # (the exit mirrors)
+    if model == 'cylindrical':
+        expected = 0.0
+    else:
+        penumbra, umbra = _cone_crossings(radius, orbit.mu)
+        expected = penumbra if min_light == 1.0 else umbra
+        assert umbra - penumbra == pytest.approx(8.22, abs=0.01)
+    assert entry <= expected < entry + 0.1 + 1e-6, (entry, expected)
+    assert leave - 0.1 - 1e-6 < -expected <= leave, (leave, expected)
+    assert body.sensor_health()['sun_sensor'] == {
+        'valid': len(read), 'eclipse': len(ticks) - len(read)}
+
+
+def test_the_sky_refuses_an_unknown_shadow_model_and_the_sensor_a_fraction_above_1():
+    with pytest.raises(ValueError, match='shadow_model must be one of cylindrical, conical'):
+        Sky(shadow='cone')
+    with pytest.raises(ValueError, match='sun_sensor_min_light'):
+        SunSensor(1.0, min_light=1.5)

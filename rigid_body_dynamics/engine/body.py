@@ -275,7 +275,7 @@ class BodySimulation:
         self.seed = int(seed)
         self.disturbances = disturbances or Disturbances()
         d = self.disturbances
-        self.sky = Sky(d.field, d.sun, d.planet_radius)
+        self.sky = Sky(d.field, d.sun, d.planet_radius, d.shadow_model)
         # (steps per reading, sensor): a sensor between two steps samples at the nearer one
         self.sensors = [(max(1, round(self.rate / sensor.rate)), sensor) for sensor in sensors]
         self.sensor_counts = {sensor.name: {'valid': 0} for _, sensor in self.sensors}
@@ -416,7 +416,7 @@ class BodySimulation:
                 self._schedule = self._make_schedule()
             if disturbances is not None and disturbances != self.disturbances:
                 self.disturbances = d = disturbances
-                self.sky = Sky(d.field, d.sun, d.planet_radius)
+                self.sky = Sky(d.field, d.sun, d.planet_radius, d.shadow_model)
                 self.plant.set_disturbances(d)
                 self._base_stale = True
                 lines.append(f'disturbances now {disturbances}')

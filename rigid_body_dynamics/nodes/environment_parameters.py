@@ -195,4 +195,4 @@ def environment_from(out):
     sun = sun_from(out, orbit) if 'epoch' in out else None
     return Disturbances(out['disturbance_torque_body'], out['disturbance_torque_world'], orbit,
                         field, out['gravity_gradient'], out['residual_dipole'], sun,
-                        out['planet_radius'])
+                        out['planet_radius'], out['shadow_model'])

@@ -12,6 +12,7 @@ import math
 
 from ..physics.environment import Sun
 from ..physics.sensors import Gyro, GyroErrors, Magnetometer, StarTracker, SunSensor
+from ..physics.sensors.base import SHADOW_MODELS
 from ..ros.parameters import ConfigurationError, Param
 
 #: Every sensor parameter, by name, in the order the manual lists them.
@@ -27,6 +28,11 @@ SENSOR_PARAMS = {p.name: p for p in (
     Param('sun_direction', 'double[3]', [1.0, 0.0, 0.0], '[1, 0, 0]',
           'Unit vector to the Sun in the world frame when there is no orbit (fixed; no '
           'eclipse). Normalised.', read_only=True),
+    Param('shadow_model', 'string', 'cylindrical', 'cylindrical',
+          "The Earth's shadow, with an orbit: cylindrical (a cylinder of planet_radius "
+          'behind the Earth, sunlit or not) or conical (the umbra and penumbra cones of '
+          "the Sun's and the planet's discs, Montenbruck and Gill; the fraction of the "
+          "Sun's disc uncovered).", choices=SHADOW_MODELS, read_only=True),
     Param('star_tracker_rate', 'double', 0.0, '0.0 Hz',
           'Star tracker readings per simulated second on star_tracker (Hz, 0 = off); at most '
           'integration_rate, rounded to a whole number of steps.', low=0.0, high=1e5,
@@ -61,6 +67,10 @@ SENSOR_PARAMS = {p.name: p for p in (
     Param('sun_sensor_fov', 'double', math.pi, '3.14159 rad (all directions)',
           "Half-angle of the sun sensor's field of view about its boresight (rad); outside "
           'it, or in eclipse, there is no reading.', low=0.0, high=math.pi, read_only=True),
+    Param('sun_sensor_min_light', 'double', 0.5, '0.5',
+          "The fraction of the Sun's disc the sun sensor needs uncovered to read, in the "
+          'penumbra of shadow_model conical (never in umbra; the cylinder is 0 or 1).',
+          low=0.0, high=1.0, read_only=True),
 )}
 
 
@@ -132,7 +142,8 @@ def sensors_from(out, disturbances):
                 out['star_tracker_sun_exclusion'], out['star_tracker_earth_exclusion']))
         if out['sun_sensor_rate'] > 0.0:
             sensors.append(SunSensor(out['sun_sensor_rate'], out['sun_sensor_noise'],
-                                     out['sun_sensor_boresight'], out['sun_sensor_fov']))
+                                     out['sun_sensor_boresight'], out['sun_sensor_fov'],
+                                     out['sun_sensor_min_light']))
     except ValueError as err:
         raise ConfigurationError(str(err)) from None
     return sensors

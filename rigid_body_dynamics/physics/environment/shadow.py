@@ -18,8 +18,8 @@ disc left uncovered is
 For a low orbit the penumbra lasts seconds at each shadow crossing (8.2 s on a
 400 km circular orbit with the Sun in its plane, longer where the orbit crosses
 the shadow's edge at a slant), which the cylindrical shadow of
-:func:`.sun.in_shadow` (1 or 0) cannot show. Not yet used by the sensors: the
-sun sensor still reads the cylinder.
+:func:`.sun.in_shadow` (1 or 0) cannot show. The sensors see it through
+:meth:`..sensors.base.Sky.light` with ``shadow_model`` conical.
 """
 
 import math

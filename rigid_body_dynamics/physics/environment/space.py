@@ -187,7 +187,8 @@ class Disturbances:
     body frame): the torque m x B in the field. ``sun`` (a
     :class:`~rigid_body_dynamics.physics.environment.Sun`, None = none) and
     ``planet_radius`` (m) are what the sensors see (the Sun, the shadow, the
-    Earth's disc); they make no torque.
+    Earth's disc), with ``shadow_model`` (cylindrical or conical: see
+    :class:`~rigid_body_dynamics.physics.sensors.base.Sky`); they make no torque.
     """
 
     body: tuple = _ZERO
@@ -198,6 +199,7 @@ class Disturbances:
     residual_dipole: tuple = _ZERO
     sun: object = None
     planet_radius: float = R_EARTH
+    shadow_model: str = 'cylindrical'
 
     @property
     def active(self):

@@ -15,16 +15,25 @@ date of ``epoch`` plus the simulated time:
 a unit vector in the world frame (equatorial, z along the Earth's rotation
 axis, x towards the equinox), seen from the Earth's centre: the parallax of a
 low orbit (under 5e-5 rad) is neglected. The epoch is UTC, and TT is taken as
-UTC (they differ by about 69 s, 0.0007 deg of the Sun's motion).
+UTC (they differ by about 69 s, 0.0007 deg of the Sun's motion). The same
+almanac gives the Sun's distance, which the conical shadow needs:
 
-The Earth's shadow is a cylinder of the planet's radius behind the Earth
-(no penumbra): a body at r is in eclipse when r . s < 0 and its distance from
-the Earth-Sun line is under the radius.
+    R = 1.00014 - 0.01671 cos g - 0.00014 cos 2g   (au)
+
+and without an epoch the fixed Sun is 1 au away.
+
+The Earth's shadow is, with ``shadow_model`` cylindrical, a cylinder of the
+planet's radius behind the Earth (no penumbra): a body at r is in eclipse when
+r . s < 0 and its distance from the Earth-Sun line is under the radius. With
+``shadow_model`` conical it is the Montenbruck-Gill cone with its penumbra
+(:mod:`.shadow`).
 """
 
 from datetime import datetime, timezone
 import math
 
+#: The astronomical unit (m; IAU 2012 Resolution B2).
+AU = 149597870700.0
 #: The Julian date of the Unix epoch, 1970-01-01T00:00:00Z.
 JD_UNIX = 2440587.5
 #: The Julian date of J2000.0, 2000-01-01T12:00:00 (TT).
@@ -74,6 +83,16 @@ def sun_direction_almanac(jd):
     return (math.cos(lam), math.cos(eps) * s, math.sin(eps) * s)
 
 
+def sun_distance_almanac(jd):
+    """
+    Return the distance (m) from the Earth's centre to the Sun's at Julian date ``jd`` (days).
+
+    The Astronomical Almanac's low-precision formula (module docstring; about 1e-4 au).
+    """
+    g = math.radians((357.528 + 0.9856003 * (jd - JD_J2000)) % 360.0)
+    return AU * (1.00014 - 0.01671 * math.cos(g) - 0.00014 * math.cos(2.0 * g))
+
+
 class Sun:
     """
     The Sun's direction over simulated time: from ``epoch`` (ISO 8601 UTC), or ``fixed``.
@@ -104,6 +123,12 @@ class Sun:
         if self.fixed is not None:
             return self.fixed
         return sun_direction_almanac(self.jd0 + t / _DAY)
+
+    def position(self, t):
+        """Return where the Sun is (m, world, from the Earth's centre) at time t (s)."""
+        s = self.direction(t)
+        d = AU if self.fixed is not None else sun_distance_almanac(self.jd0 + t / _DAY)
+        return (d * s[0], d * s[1], d * s[2])
 
 
 def in_shadow(r, sun, radius):

@@ -32,7 +32,11 @@ from typing import NamedTuple
 import numpy as np
 
 from ..environment.orbit import R_EARTH
+from ..environment.shadow import conical_shadow_fraction
 from ..environment.sun import in_shadow
+
+#: The Earth's shadow models a sensor can see: cylindrical (0 or 1), conical (a penumbra).
+SHADOW_MODELS = ('cylindrical', 'conical')
 
 
 class Sky:
@@ -41,11 +45,16 @@ class Sky:
 
     ``field``: a :class:`~..environment.magnetic_field.DipoleField` (None =
     none); ``sun``: a :class:`~..environment.sun.Sun` (None = none);
-    ``planet_radius`` (m) for eclipses and the Earth's disc.
+    ``planet_radius`` (m) for eclipses and the Earth's disc; ``shadow``: one of
+    :data:`SHADOW_MODELS` (ValueError naming ``shadow_model`` otherwise).
     """
 
-    def __init__(self, field=None, sun=None, planet_radius=R_EARTH):
+    def __init__(self, field=None, sun=None, planet_radius=R_EARTH, shadow='cylindrical'):
+        if shadow not in SHADOW_MODELS:
+            raise ValueError(f'shadow_model must be one of {", ".join(SHADOW_MODELS)}, '
+                             f'got {shadow!r}')
         self.field, self.sun, self.planet_radius = field, sun, float(planet_radius)
+        self.shadow = shadow
 
     def field_world(self, t, r):
         """Return the magnetic field (T, world) at time t (s) and position r (m, world)."""
@@ -55,9 +64,18 @@ class Sky:
         """Return the unit vector to the Sun (world) at time t (s)."""
         return self.sun.direction(t)
 
-    def eclipsed(self, t, r):
-        """Tell whether position r (m, world; None = no orbit) is in the shadow at t (s)."""
-        return r is not None and in_shadow(r, self.sun.direction(t), self.planet_radius)
+    def light(self, t, r):
+        """
+        Return the fraction of the Sun's disc seen from r (m, world; None = no orbit) at t (s).
+
+        1 in full sunlight (and without an orbit), 0 in umbra; with the cylindrical
+        shadow nothing between, with the conical one the penumbra's fraction.
+        """
+        if r is None:
+            return 1.0
+        if self.shadow == 'conical':
+            return conical_shadow_fraction(r, self.sun.position(t), self.planet_radius)
+        return 0.0 if in_shadow(r, self.sun.direction(t), self.planet_radius) else 1.0
 
     def planet_angular_radius(self, r):
         """Return the angular radius (rad) of the planet's disc seen from r (m, world)."""

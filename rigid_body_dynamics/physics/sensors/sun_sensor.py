@@ -7,7 +7,11 @@ A sun sensor: the unit Sun direction in the body frame, turned by a small random
 rotation about s itself changing nothing). A reading exists only when the Sun
 is within ``fov`` (half-angle, rad; pi = all directions) of the ``boresight``
 (a body unit vector) and the body is not in the planet's shadow; otherwise the
-engine counts it as ``'fov'`` or ``'eclipse'``.
+engine counts it as ``'fov'`` or ``'eclipse'``. In the conical shadow's penumbra
+the sensor reads while at least ``min_light`` of the Sun's disc is uncovered
+(and never in umbra), and then reads the direction to the disc's centre: the
+visible part's centroid is off it by less than the Sun's angular radius
+(4.65e-3 rad), which this model neglects.
 """
 
 import math
@@ -28,13 +32,16 @@ class SunSensor:
     """
     A sun sensor at ``rate`` Hz: ``noise`` (rad), ``boresight`` (body), ``fov`` (rad).
 
+    ``min_light`` (0 to 1): the fraction of the Sun's disc it needs uncovered.
+
     Bad values raise ValueError naming the simulator's parameter.
     """
 
     name = 'sun_sensor'
     stream = 3
 
-    def __init__(self, rate, noise=0.0, boresight=(0.0, 0.0, 1.0), fov=math.pi):
+    def __init__(self, rate, noise=0.0, boresight=(0.0, 0.0, 1.0), fov=math.pi,
+                 min_light=0.5):
         self.rate = check_rate('sun_sensor_rate', rate)
         self.noise = check_scalar('sun_sensor_noise', noise, 'rad', 1.0)
         b = check_vector('sun_sensor_boresight', boresight, 'body unit vector')
@@ -44,6 +51,7 @@ class SunSensor:
         self.boresight = tuple(c / n for c in b)
         self.fov = check_scalar('sun_sensor_fov', fov, 'rad', math.pi)
         self.variance = self.noise ** 2
+        self.min_light = check_scalar('sun_sensor_min_light', min_light, 'of the disc', 1.0)
 
     def start(self, rng, rate):
         """Start (nothing to draw)."""
@@ -52,7 +60,8 @@ class SunSensor:
         """Return a :class:`SunSensorReading` of ``state`` at t (s), or why there is none."""
         e = (rng.standard_normal(3) * self.noise).tolist()      # drawn whatever the view
         sky = state.sky
-        if sky.eclipsed(t, state.position):
+        light = sky.light(t, state.position)
+        if light <= 0.0 or light < self.min_light:
             return 'eclipse'
         q = state.q
         s = quat.rotate_components((-q[0], -q[1], -q[2], q[3]), sky.sun_world(t))
