@@ -10,9 +10,11 @@ gravity gradient, magnetic dipoles, magnetorquers) and :mod:`.space`
 :mod:`.sun` (the Sun's direction and the Earth's cylindrical shadow) and
 :mod:`.shadow` (the conical shadow with its penumbra); :mod:`.zonal_orbit` (the
 orbit integrated under J2..J6) and :mod:`.chebyshev` (the interpolants both it and
-the IGRF field use along the orbit).
+the IGRF field use along the orbit); :mod:`.facets` (a faceted surface's solar
+radiation pressure and drag).
 """
 
+from .facets import Facets, solar_pressure_at
 from .igrf_field import igrf_coefficients, igrf_fixed, IgrfField
 from .magnetic_field import DipoleField, EARTH_RATE, IGRF13_2020, R_REF
 from .orbit import circular_elements, KeplerOrbit, lvlh_axes, lvlh_quaternion, MU_EARTH, R_EARTH
@@ -24,10 +26,11 @@ from .torque_models import GravityGradient, MagneticDipole, Magnetorquers
 from .zonal_orbit import ZonalOrbit
 
 __all__ = ['circular_elements', 'conical_shadow_fraction', 'DipoleField', 'Disturbances',
-           'EARTH_RATE', 'GravityGradient',
+           'EARTH_RATE', 'Facets', 'GravityGradient',
            'greenwich_mean_sidereal_time', 'IGRF13_2020', 'igrf_coefficients', 'igrf_fixed',
            'IgrfField', 'in_shadow', 'julian_date',
            'KeplerOrbit', 'lvlh_axes', 'lvlh_quaternion', 'MagneticDipole', 'Magnetorquers',
-           'MU_EARTH', 'MU_WGS72', 'R_EARTH', 'R_REF', 'R_SUN', 'SpaceEnvironment', 'Sun',
+           'MU_EARTH', 'MU_WGS72', 'R_EARTH', 'R_REF', 'R_SUN', 'solar_pressure_at',
+           'SpaceEnvironment', 'Sun',
            'sun_direction_almanac', 'Surroundings', 'TleOrbit', 'unix_time',
            'ZonalOrbit']
