@@ -170,13 +170,20 @@ def _environments():
     eccentric, circular = KeplerOrbit(ELEMENTS), KeplerOrbit(circular_elements(5e5, 0.9))
     gravity = GravityGradient(moments, MU_EARTH)
     dipole = MagneticDipole((0.3, -0.1, 0.2))
+    # a box with its centre of mass off its centre, in sunlight and the conical shadow
+    from rigid_body_dynamics.physics.environment import SolarPressureTorque, Sun
+    from rigid_body_dynamics.physics.environment.facets import box, Facets
+    srp = SolarPressureTorque(Facets(box((0.1, 0.2, 0.3), (0.01, -0.02, 0.005), 0.3, 0.2)))
     return [('gravity gradient', SpaceEnvironment(eccentric, None, [gravity], epoch=30.0)),
             ('dipole', SpaceEnvironment(circular, DipoleField(), [dipole])),
             ('both', SpaceEnvironment(eccentric, DipoleField(rotation_angle=0.4),
-                                      [gravity, dipole], epoch=1e4))]
+                                      [gravity, dipole], epoch=1e4)),
+            ('solar pressure', SpaceEnvironment(
+                circular, DipoleField(), [gravity, srp, dipole], epoch=2e3,
+                sun=Sun('2026-03-20T12:00:00Z'), shadow='conical'))]
 
 
-@pytest.mark.parametrize('case', range(3))
+@pytest.mark.parametrize('case', range(4))
 def test_the_stage_statements_give_each_models_own_torque(rng, case):
     """
     The statements the integrators put into their stages give what the models' torque() does.
@@ -194,7 +201,7 @@ def test_the_stage_statements_give_each_models_own_torque(rng, case):
                                    atol=4e-15 * np.linalg.norm(expected))
 
 
-@pytest.mark.parametrize('case', range(3))
+@pytest.mark.parametrize('case', range(4))
 @pytest.mark.parametrize('integrator', ['exact', 'rk4', 'wheels exact', 'wheels rk4'])
 def test_a_step_with_the_environment_in_its_stages_is_the_step_that_calls_the_models(
         case, integrator):
@@ -210,7 +217,7 @@ def test_a_step_with_the_environment_in_its_stages_is_the_step_that_calls_the_mo
     from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator, Wheels
     name, inlined = _environments()[case]
     called = SpaceEnvironment(inlined.orbit, inlined.field, inlined.models, inlined.epoch,
-                              stages=False)
+                              stages=False, sun=inlined.sun, shadow=inlined.shadow)
     q0, w0 = quaternions.normalize(np.array([0.1, 0.2, -0.3, 0.9])), (0.3, -0.5, 0.8)
     wheels = Wheels([c / math.sqrt(3.0) for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
                      for c in g], (0.01,) * 4, coulomb=(1e-4,) * 4, viscous=(1e-6,) * 4)

@@ -117,3 +117,41 @@ def test_the_pressure_at_1_au_and_its_inverse_square():
 def test_bad_facets_are_refused_naming_the_facet(values, reason):
     with pytest.raises(ValueError, match=reason):
         Facets(values)
+
+
+def test_the_solar_pressure_torque_is_zero_in_umbra_and_scaled_in_the_penumbra():
+    """
+    The SolarPressureTorque in a SpaceEnvironment (its stage statements) at three places.
+
+    A 400 km circular orbit with the Sun 1 au along x: in sunlight, half-way through the
+    penumbra (the conical fraction there) and in umbra. Against the facets' own force with
+    the pressure 1361 W/m^2 / c (au / d)^2 times the fraction, d and the direction to the
+    Sun taken from the body (not the Earth's centre), to 1e-14; exactly zero in umbra.
+    """
+    from rigid_body_dynamics.physics.environment import (circular_elements, KeplerOrbit,
+                                                         R_EARTH, SolarPressureTorque,
+                                                         SpaceEnvironment, Sun)
+    from rigid_body_dynamics.physics.environment.shadow import conical_shadow_fraction
+    from scipy.optimize import brentq
+    surface = Facets(box((0.1, 0.2, 0.3), (0.01, -0.02, 0.005), SPECULAR, DIFFUSE))
+    orbit = KeplerOrbit(circular_elements(400e3))
+    env = SpaceEnvironment(orbit, None, [SolarPressureTorque(surface)],
+                           sun=Sun(fixed=(1.0, 0.0, 0.0)), shadow='conical')
+    assert env.stage_code is not None and env.stage_code.sun
+    sun = np.array([149597870700.0, 0.0, 0.0])
+    light = lambda t: conical_shadow_fraction(orbit.position(t), sun, R_EARTH)  # noqa: E731
+    half = brentq(lambda t: light(t) - 0.5, 0.2 * orbit.period, 0.5 * orbit.period)
+    q = Rotation.from_euler('xyz', [0.3, -0.4, 1.1])
+    for t, fraction in ((0.0, 1.0), (half, 0.5), (0.5 * orbit.period, 0.0)):
+        r = np.array(orbit.position(t))
+        to_sun = sun - r
+        d = np.linalg.norm(to_sun)
+        pressure = 1361.0 / 299792458.0 * (149597870700.0 / d) ** 2 * light(t)
+        assert light(t) == pytest.approx(fraction, abs=1e-12)
+        _, expected = surface.solar_pressure(q.inv().apply(to_sun / d), pressure)
+        got = np.array(env(t, *q.as_quat()))
+        if fraction == 0.0:
+            assert not np.any(got)
+        else:
+            assert np.max(np.abs(got - expected)) < 1e-14 * np.linalg.norm(expected), t
+            assert np.linalg.norm(expected) > 1e-10

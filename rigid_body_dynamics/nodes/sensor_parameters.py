@@ -11,8 +11,8 @@ with a reason that names the parameter.
 import math
 
 from ..physics.environment import Sun
+from ..physics.environment.shadow import SHADOW_MODELS
 from ..physics.sensors import Gyro, GyroErrors, Magnetometer, StarTracker, SunSensor
-from ..physics.sensors.base import SHADOW_MODELS
 from ..ros.parameters import ConfigurationError, Param
 
 #: Every sensor parameter, by name, in the order the manual lists them.

@@ -22,7 +22,7 @@ from .shadow import conical_shadow_fraction, R_SUN
 from .space import Disturbances, SpaceEnvironment, Surroundings
 from .sun import in_shadow, julian_date, Sun, sun_direction_almanac, unix_time
 from .tle_orbit import greenwich_mean_sidereal_time, MU_WGS72, TleOrbit
-from .torque_models import GravityGradient, MagneticDipole, Magnetorquers
+from .torque_models import GravityGradient, MagneticDipole, Magnetorquers, SolarPressureTorque
 from .zonal_orbit import ZonalOrbit
 
 __all__ = ['circular_elements', 'conical_shadow_fraction', 'DipoleField', 'Disturbances',
@@ -31,6 +31,6 @@ __all__ = ['circular_elements', 'conical_shadow_fraction', 'DipoleField', 'Distu
            'IgrfField', 'in_shadow', 'julian_date',
            'KeplerOrbit', 'lvlh_axes', 'lvlh_quaternion', 'MagneticDipole', 'Magnetorquers',
            'MU_EARTH', 'MU_WGS72', 'R_EARTH', 'R_REF', 'R_SUN', 'solar_pressure_at',
-           'SpaceEnvironment', 'Sun',
+           'SolarPressureTorque', 'SpaceEnvironment', 'Sun',
            'sun_direction_almanac', 'Surroundings', 'TleOrbit', 'unix_time',
            'ZonalOrbit']

@@ -84,6 +84,20 @@ class Facets:
     def __len__(self):
         return len(self.area)
 
+    def turned(self, turn):
+        """
+        Return these facets with normals and centres given in another frame.
+
+        ``turn(v)`` maps a vector of this frame to the other (a rotation, e.g. the body
+        frame to the principal frame of the inertia).
+        """
+        out = object.__new__(Facets)
+        out.area, out.specular, out.diffuse, out.drag = (
+            self.area, self.specular, self.diffuse, self.drag)
+        out.normal = np.array([turn(n) for n in self.normal], dtype=float).reshape(-1, 3)
+        out.centre = np.array([turn(c) for c in self.centre], dtype=float).reshape(-1, 3)
+        return out
+
     def solar_pressure(self, sun, pressure):
         """
         Return (force (N), torque (N m)) of solar radiation pressure, body frame.

@@ -24,6 +24,8 @@ the shadow's edge at a slant), which the cylindrical shadow of
 
 import math
 
+from .sun import in_shadow
+
 #: The Sun's nominal radius (m; IAU 2015 Resolution B3).
 R_SUN = 6.957e8
 
@@ -59,3 +61,23 @@ def conical_shadow_fraction(r, sun_position, planet_radius, sun_radius=R_SUN):
     overlap = (a * a * math.acos(max(-1.0, min(1.0, x / a)))
                + b * b * math.acos(max(-1.0, min(1.0, (c - x) / b))) - c * y)
     return min(1.0, max(0.0, 1.0 - overlap / (math.pi * a * a)))
+
+
+#: The Earth's shadow models: cylindrical (0 or 1), conical (with a penumbra).
+SHADOW_MODELS = ('cylindrical', 'conical')
+
+
+def sunlit_fraction(r, sun_position, planet_radius, model='cylindrical'):
+    """
+    Return the fraction of the Sun's light that reaches ``r`` (0 = umbra, 1 = full sunlight).
+
+    ``r`` and ``sun_position`` (m, world, from the planet's centre), ``planet_radius``
+    (m); ``model`` one of :data:`SHADOW_MODELS`: the cylinder of the planet's radius
+    behind it (0 or 1, :func:`.sun.in_shadow`) or the cone with its penumbra
+    (:func:`conical_shadow_fraction`).
+    """
+    if model == 'conical':
+        return conical_shadow_fraction(r, sun_position, planet_radius)
+    d = math.sqrt(sun_position[0] ** 2 + sun_position[1] ** 2 + sun_position[2] ** 2)
+    sun = (sun_position[0] / d, sun_position[1] / d, sun_position[2] / d)
+    return 0.0 if in_shadow(r, sun, planet_radius) else 1.0

@@ -15,8 +15,11 @@ parameters say).
 from dataclasses import dataclass
 import math
 
+from .facets import SOLAR_PRESSURE_1AU
 from .orbit import R_EARTH
+from .shadow import sunlit_fraction
 from .stage_code import stage_code, torque_source
+from .sun import AU
 from ..dynamics.rk_kernels import compile_source
 
 _ZERO = (0.0, 0.0, 0.0)
@@ -26,14 +29,17 @@ class Surroundings:
     """
     What the models share at one stage: ``r_body`` (m) and ``b_body`` (T), principal frame.
 
-    Also ``r_world`` (m) and ``b_world`` (T); None where the environment has no orbit or
-    no field.
+    Also ``r_world`` (m) and ``b_world`` (T); with the Sun, ``s_world`` and ``s_body``
+    (the unit direction from the body to the Sun) and ``pressure`` (the solar radiation
+    pressure there, N/m^2, the shadow's fraction included). None where the environment
+    has no orbit, no field or no Sun.
     """
 
-    __slots__ = ('r_world', 'r_body', 'b_world', 'b_body')
+    __slots__ = ('r_world', 'r_body', 'b_world', 'b_body', 's_world', 's_body', 'pressure')
 
     def __init__(self):
         self.r_world = self.r_body = self.b_world = self.b_body = None
+        self.s_world = self.s_body = self.pressure = None
 
 
 def _to_body(qx, qy, qz, qw, v):
@@ -58,7 +64,10 @@ class SpaceEnvironment:
     integrator's time (the simulated time at the integrator's time 0).
     A model that needs the position without an orbit, or the field without one,
     is refused with ValueError. ``stages`` False calls the models at every stage even
-    when they have statements (to compare the two).
+    when they have statements (to compare the two). ``sun`` (a
+    :class:`~.sun.Sun`), ``shadow`` (a :data:`~.shadow.SHADOW_MODELS` name) and
+    ``planet_radius`` (m) give the Sun to models whose ``needs`` has 'sun' (refused
+    without a Sun or an orbit).
 
     Called as ``env(t, qx, qy, qz, qw, wx, wy, wz)`` (t in s, q principal ->
     world, omega rad/s principal) it returns the summed torque (N m, principal).
@@ -69,11 +78,19 @@ class SpaceEnvironment:
     makes on every change.
     """
 
-    def __init__(self, orbit=None, field=None, models=(), epoch=0.0, stages=True):
+    def __init__(self, orbit=None, field=None, models=(), epoch=0.0, stages=True, sun=None,
+                 shadow='cylindrical', planet_radius=R_EARTH):
         self.orbit, self.field, self.models = orbit, field, tuple(models)
+        self.sun, self.shadow, self.planet_radius = sun, shadow, float(planet_radius)
         needs = set()
         for model in self.models:
             needs |= model.needs
+        self._sun = 'sun' in needs
+        if self._sun:
+            if sun is None or orbit is None:
+                raise ValueError('solar radiation pressure needs an orbit and the Sun '
+                                 '(orbit_elements or orbit_tle, and epoch)')
+            needs.add('position')
         if field is not None:
             needs.add('field')
         if 'field' in needs:
@@ -102,10 +119,12 @@ class SpaceEnvironment:
 
     def world_at(self, t):
         """
-        Return (r (m, 3), norm(r)^2 (m^2), B (T, 3)), world frame, at integrator time t (s).
+        Return (r (m, 3), norm(r)^2 (m^2), B (T, 3), s (3), P), world frame, at time t (s).
 
-        A flat tuple; r and its norm only when the models need the position, B only
-        with a field (see :class:`~.stage_code.StageCode`).
+        A flat tuple at integrator time t; r and its norm only when the models need the
+        position, B only with a field, the unit direction s from the body to the Sun
+        and the solar radiation pressure P there (N/m^2, times the shadow's sunlit
+        fraction) only when a model needs the Sun (see :class:`~.stage_code.StageCode`).
         """
         world = self._world.get(t)
         if world is None:
@@ -118,8 +137,18 @@ class SpaceEnvironment:
             world = r + (r[0] * r[0] + r[1] * r[1] + r[2] * r[2],)
             if self._field:
                 world += self.field.world(s, r)
+            if self._sun:
+                world += self._sunlight(s, r)
             world = self._world[t] = world
         return world
+
+    def _sunlight(self, s, r):
+        """Return (s_x, s_y, s_z, P): the unit direction to the Sun from r (m) and P (N/m^2)."""
+        sun = self.sun.position(s)
+        dx, dy, dz = sun[0] - r[0], sun[1] - r[1], sun[2] - r[2]
+        d = math.sqrt(dx * dx + dy * dy + dz * dz)
+        light = sunlit_fraction(r, sun, self.planet_radius, self.shadow)
+        return (dx / d, dy / d, dz / d, SOLAR_PRESSURE_1AU * (AU / d) ** 2 * light)
 
     def surroundings(self, t, q):
         """Fill and return the :class:`Surroundings` at integrator time t (s) and attitude q."""
@@ -129,8 +158,11 @@ class SpaceEnvironment:
             env.r_world = world[:3]
             env.r_body = _to_body(*q, env.r_world)
             if self._field:
-                env.b_world = world[4:]
+                env.b_world = world[4:7]
                 env.b_body = _to_body(*q, env.b_world)
+            if self._sun:
+                env.s_world, env.pressure = world[-4:-1], world[-1]
+                env.s_body = _to_body(*q, env.s_world)
         return env
 
     def __call__(self, t, qx, qy, qz, qw, wx=0.0, wy=0.0, wz=0.0):
@@ -188,7 +220,10 @@ class Disturbances:
     :class:`~rigid_body_dynamics.physics.environment.Sun`, None = none) and
     ``planet_radius`` (m) are what the sensors see (the Sun, the shadow, the
     Earth's disc), with ``shadow_model`` (cylindrical or conical: see
-    :class:`~rigid_body_dynamics.physics.sensors.base.Sky`); they make no torque.
+    :class:`~rigid_body_dynamics.physics.sensors.base.Sky`). ``facets`` (a
+    :class:`~.facets.Facets`, body frame; None = none) is the body's surface, and
+    ``solar_pressure`` the torque of the Sun's light on it (needs the orbit, the Sun
+    and facets).
     """
 
     body: tuple = _ZERO
@@ -200,12 +235,14 @@ class Disturbances:
     sun: object = None
     planet_radius: float = R_EARTH
     shadow_model: str = 'cylindrical'
+    facets: object = None
+    solar_pressure: bool = False
 
     @property
     def active(self):
         """Whether any disturbance torque acts."""
         return bool(any(self.body) or any(self.world) or self.gravity_gradient
-                    or any(self.residual_dipole))
+                    or any(self.residual_dipole) or self.solar_pressure)
 
     def __str__(self):
         parts = [f'{name} {value}' for name, value in (
@@ -213,4 +250,7 @@ class Disturbances:
             ('residual dipole', self.residual_dipole)) if any(value)]
         if self.gravity_gradient:
             parts.append('gravity gradient')
+        if self.solar_pressure:
+            parts.append(f'solar pressure on {len(self.facets)} facets ({self.shadow_model} '
+                         'shadow)')
         return ', '.join(parts) or 'none'

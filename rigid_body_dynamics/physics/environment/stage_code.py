@@ -22,8 +22,11 @@ A model takes part by a method ``stage_source(prefix)`` returning
 (each name starting with ``prefix``), read when the environment is made;
 ``lines`` statements that may read ``r_bx, r_by, r_bz`` (position, principal
 frame, m), ``r_rr`` (its squared norm, m^2), ``b_bx, b_by, b_bz`` (field,
-principal frame, T), ``o_x, o_y, o_z`` (the stage's angular velocity, rad/s,
-principal frame; the model's ``needs`` has 'rate'), ``sqrt`` and its constants,
+principal frame, T), ``s_bx, s_by, s_bz`` (the unit direction from the body to the
+Sun, principal frame) and ``s_p`` (the solar radiation pressure there, N/m^2, the
+shadow's fraction included; the model's ``needs`` has 'sun'), ``o_x, o_y, o_z``
+(the stage's angular velocity, rad/s, principal frame; the model's ``needs`` has
+'rate'), ``sqrt`` and its constants,
 and set names starting with ``prefix``; ``torque`` three expressions of its torque
 components. The model's ``torque()`` stays its definition (tests hold the two to
 round-off). An environment with a model that has no ``stage_source`` (one that
@@ -31,7 +34,8 @@ needs the time, say) is evaluated through the models' ``torque()`` at every stag
 as before: slower, never different.
 """
 
-_STAGE_NAMES = ('r_bx', 'r_by', 'r_bz', 'r_rr', 'b_bx', 'b_by', 'b_bz')
+_STAGE_NAMES = ('r_bx', 'r_by', 'r_bz', 'r_rr', 'b_bx', 'b_by', 'b_bz', 's_bx', 's_by', 's_bz',
+                's_p')
 
 
 class StageCode:
@@ -39,14 +43,14 @@ class StageCode:
     The statements of an environment's summed torque at one stage, and their constants.
 
     ``models`` (each with ``stage_source``, see the module docstring),
-    ``position``, ``field`` and ``rate``: whether the stages need the position, the
-    field and the angular velocity. ``key`` identifies the generated source (the same key, the same
-    statements: one compiled kernel serves every environment of that shape);
-    ``names`` and ``values`` the constants, which a kernel unpacks from the
-    environment's ``constants`` at each step.
+    ``position``, ``field``, ``rate`` and ``sun``: whether the stages need the
+    position, the field, the angular velocity and the Sun. ``key`` identifies the
+    generated source (the same key, the same statements: one compiled kernel serves
+    every environment of that shape); ``names`` and ``values`` the constants, which
+    a kernel unpacks from the environment's ``constants`` at each step.
     """
 
-    def __init__(self, models, position, field, rate=False):
+    def __init__(self, models, position, field, rate=False, sun=False):
         constants, lines, sums = {}, [], ([], [], [])
         for n, model in enumerate(models):
             prefix = f'm{n}_'
@@ -60,16 +64,19 @@ class StageCode:
             for total, term in zip(sums, torque):
                 total.append(f'({term})')
         self.position, self.field, self.rate = bool(position), bool(field), bool(rate)
+        self.sun = bool(sun)
         self.names = tuple(constants)
         self.values = tuple(float(v) for v in constants.values())
         self.lines = tuple(lines)
         self.torque = tuple(' + '.join(terms) or '0.0' for terms in sums)
-        self.key = (self.position, self.field, self.rate, self.names, self.lines, self.torque)
+        self.key = (self.position, self.field, self.rate, self.sun, self.names, self.lines,
+                    self.torque)
 
     def world_names(self, j):
-        """Names of node j's world quantities: r (m), its squared norm, and B (T)."""
+        """Names of node j's world quantities: r (m), its squared norm, B (T), the Sun."""
         names = [f'r_wx{j}', f'r_wy{j}', f'r_wz{j}', f'r_rr{j}'] if self.position else []
-        return names + ([f'b_wx{j}', f'b_wy{j}', f'b_wz{j}'] if self.field else [])
+        names += [f'b_wx{j}', f'b_wy{j}', f'b_wz{j}'] if self.field else []
+        return names + ([f's_wx{j}', f's_wy{j}', f's_wz{j}', f's_pp{j}'] if self.sun else [])
 
     def prologue(self, indent='    '):
         """Statements once per step: ``world`` and the constants from the environment ``field``."""
@@ -96,9 +103,9 @@ class StageCode:
         """
         qx, qy, qz, qw = q
         lines = [f'o_x, o_y, o_z = {", ".join(w)}'] if self.rate else []
-        if self.position or self.field:
+        if self.position or self.field or self.sun:
             lines.append(f's_q = 2.0 / ({qx} * {qx} + {qy} * {qy} + {qz} * {qz} + {qw} * {qw})')
-        for kind, on in (('r', self.position), ('b', self.field)):
+        for kind, on in (('r', self.position), ('b', self.field), ('s', self.sun)):
             if not on:
                 continue
             vx, vy, vz = f'{kind}_wx{j}', f'{kind}_wy{j}', f'{kind}_wz{j}'
@@ -111,6 +118,8 @@ class StageCode:
                       f'{kind}_bz = {vz} + {qw} * s_uz - ({qx} * s_uy - {qy} * s_ux)']
         if self.position:
             lines.append(f'r_rr = r_rr{j}')
+        if self.sun:
+            lines.append(f's_p = s_pp{j}')
         lines += list(self.lines)
         lines += [f'fx = {self.torque[0]}', f'fy = {self.torque[1]}', f'fz = {self.torque[2]}']
         return [indent + line for line in lines]
@@ -120,7 +129,8 @@ def stage_code(models, position, field):
     """Return the :class:`StageCode` of ``models``, or None when one has no ``stage_source``."""
     if not all(hasattr(model, 'stage_source') for model in models):
         return None
-    return StageCode(models, position, field, any('rate' in model.needs for model in models))
+    return StageCode(models, position, field, any('rate' in model.needs for model in models),
+                     any('sun' in model.needs for model in models))
 
 
 def torque_source(code, name='torque'):

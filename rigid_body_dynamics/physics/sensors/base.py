@@ -32,11 +32,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..environment.orbit import R_EARTH
-from ..environment.shadow import conical_shadow_fraction
-from ..environment.sun import in_shadow
-
-#: The Earth's shadow models a sensor can see: cylindrical (0 or 1), conical (a penumbra).
-SHADOW_MODELS = ('cylindrical', 'conical')
+from ..environment.shadow import SHADOW_MODELS, sunlit_fraction
 
 
 class Sky:
@@ -73,9 +69,7 @@ class Sky:
         """
         if r is None:
             return 1.0
-        if self.shadow == 'conical':
-            return conical_shadow_fraction(r, self.sun.position(t), self.planet_radius)
-        return 0.0 if in_shadow(r, self.sun.direction(t), self.planet_radius) else 1.0
+        return sunlit_fraction(r, self.sun.position(t), self.planet_radius, self.shadow)
 
     def planet_angular_radius(self, r):
         """Return the angular radius (rad) of the planet's disc seen from r (m, world)."""
