@@ -284,6 +284,17 @@ def test_the_igrf_comparison_prints_what_the_tle_tutorial_says():
     assert run.stdout == blocks[-1], (run.stdout, blocks[-1])
 
 
+def test_the_solar_pressure_example_prints_what_the_tle_tutorial_says():
+    """doc/examples/solar_pressure.py: its two lines are the tutorial's block after its name."""
+    run = subprocess.run([sys.executable, str(DOC / 'examples' / 'solar_pressure.py')],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    page = (DOC / 'tutorials' / 'satellite_tle.md').read_text()
+    block = re.search(r'solar_pressure\.py` prints:\n\n```text\n(.*?)^```', page,
+                      re.S | re.M).group(1)
+    assert run.stdout == block, (run.stdout, block)
+
+
 def test_the_torque_model_example_runs_in_the_stages_and_balances_its_energy():
     """doc/examples/torque_model.py: its model in the stages, at round-off, dissipating."""
     run = subprocess.run([sys.executable, str(DOC / 'examples' / 'torque_model.py')],

@@ -268,6 +268,13 @@ def test_an_orbit_under_j2_to_j6_over_topics(launch, probe):
      'orbit_zonal_degree must be 0 (Kepler) or an integer 2..6'),
     (('-p', f'orbit_tle:={list(ISS)}', '-p', 'orbit_zonal_degree:=2'),
      'orbit_zonal_degree 2 needs orbit_elements'),
+    (('-p', 'orbit_elements:=[7.0e6, 0.0, 0.0, 0.0, 0.0, 0.0]', '-p', 'solar_pressure:=true'),
+     'solar_pressure needs epoch (where the Sun is) and facets (the surface it pushes on)'),
+    (('-p', 'solar_pressure:=true', '-p', 'epoch:=2026-03-20T12:00:00Z', '-p',
+      'facets:=[0.01, 0.0, 0.0, 1.0, 0.05, 0.0, 0.0, 0.3, 0.2, 2.2]'),
+     'solar_pressure needs an orbit (orbit_elements or orbit_tle)'),
+    (('-p', 'facets:=[0.01, 0.0, 0.0, 1.0, 0.05, 0.0, 0.0]'),
+     'facets must hold 10 numbers per facet'),
 ])
 def test_bad_environment_parameters_are_refused_at_start_naming_them(launch, args, reason):
     proc = launch(SIM, *args, name='bad_environment')

@@ -11,10 +11,12 @@ that names the parameter.
 
 from .sensor_parameters import epoch_of, sun_from
 from ..engine import Disturbances
-from ..physics.environment import (DipoleField, EARTH_RATE, greenwich_mean_sidereal_time,
-                                   IGRF13_2020, IgrfField, julian_date, KeplerOrbit, MU_EARTH,
-                                   R_EARTH, TleOrbit, unix_time, ZonalOrbit)
-from ..ros.parameters import ConfigurationError, Param
+from ..physics.environment import (DipoleField, EARTH_RATE, Facets,
+                                   greenwich_mean_sidereal_time, IGRF13_2020, IgrfField,
+                                   julian_date, KeplerOrbit, MU_EARTH, R_EARTH, TleOrbit,
+                                   unix_time, ZonalOrbit)
+from ..physics.environment.facets import FACET_FIELDS
+from ..ros.parameters import ConfigurationError, number_list, Param
 
 _IGRF = [float(c) for c in IGRF13_2020]
 
@@ -84,6 +86,18 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
     Param('magnetometer_bias', 'double[3]', [0.0, 0.0, 0.0], '[0, 0, 0] T',
           'Constant bias of the magnetometer (T, body frame); not in the covariance.',
           read_only=True),
+    Param('facets', 'double[]', None, '[] (none)',
+          f"The body's surface as flat facets, {len(FACET_FIELDS)} numbers per facet: area "
+          '(m^2), outward normal nx, ny, nz (body frame; normalised), centre of pressure '
+          'cx, cy, cz (m, body frame, from the centre of mass), specular and diffuse '
+          'reflection coefficients (each >= 0, their sum <= 1; the rest is absorbed) and the '
+          'drag coefficient. Self-shadowing is not modelled (exact for a convex body). For '
+          'solar_pressure.', read_only=True, convert=number_list('facets')),
+    Param('solar_pressure', 'bool', False, 'false',
+          "The torque of the Sun's light on the facets (Montenbruck and Gill's absorbed, "
+          'specular and diffuse parts; 1361 W/m^2 / c at 1 au, scaled by the inverse square '
+          "of the Sun's distance and by shadow_model's sunlit fraction), evaluated at every "
+          'integrator stage. Needs an orbit, epoch and facets.', read_only=True),
     Param('lvlh_frame', 'string', 'lvlh', '`lvlh`',
           "Frame id of the orbit's LVLH frame (z nadir, y minus the orbit normal), "
           'broadcast as world_frame -> lvlh_frame on /tf with an orbit.', read_only=True),
@@ -193,6 +207,25 @@ def environment_from(out):
         raise ConfigurationError('magnetorquer_max_dipole must be >= 0 per axis (0 = no limit), '
                                  f'got {list(out["magnetorquer_max_dipole"])}')
     sun = sun_from(out, orbit) if 'epoch' in out else None
+    facets = facets_from(out)
+    if out['solar_pressure']:
+        missing = [what for what, absent in (
+            ('an orbit (orbit_elements or orbit_tle)', orbit is None),
+            ('epoch (where the Sun is)', sun is None),
+            ('facets (the surface it pushes on)', facets is None)) if absent]
+        if missing:
+            raise ConfigurationError(f'solar_pressure needs {" and ".join(missing)}')
     return Disturbances(out['disturbance_torque_body'], out['disturbance_torque_world'], orbit,
                         field, out['gravity_gradient'], out['residual_dipole'], sun,
-                        out['planet_radius'], out['shadow_model'])
+                        out['planet_radius'], out['shadow_model'], facets,
+                        out['solar_pressure'])
+
+
+def facets_from(out):
+    """Return the :class:`Facets` of validated values ``out`` (None when facets is unset)."""
+    if not out.get('facets'):
+        return None
+    try:
+        return Facets(out['facets'])
+    except ValueError as err:
+        raise ConfigurationError(str(err)) from None
