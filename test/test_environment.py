@@ -170,20 +170,26 @@ def _environments():
     eccentric, circular = KeplerOrbit(ELEMENTS), KeplerOrbit(circular_elements(5e5, 0.9))
     gravity = GravityGradient(moments, MU_EARTH)
     dipole = MagneticDipole((0.3, -0.1, 0.2))
-    # a box with its centre of mass off its centre, in sunlight and the conical shadow
-    from rigid_body_dynamics.physics.environment import SolarPressureTorque, Sun
+    # a box with its centre of mass off its centre, in sunlight and the conical shadow; in
+    # the air at 300 km (drag 30 times the light's torque), without a field
+    from rigid_body_dynamics.physics.environment import (DragTorque, ExponentialAtmosphere,
+                                                         SolarPressureTorque, Sun)
     from rigid_body_dynamics.physics.environment.facets import box, Facets
-    srp = SolarPressureTorque(Facets(box((0.1, 0.2, 0.3), (0.01, -0.02, 0.005), 0.3, 0.2)))
+    surface = Facets(box((0.1, 0.2, 0.3), (0.01, -0.02, 0.005), 0.3, 0.2))
+    srp, drag = SolarPressureTorque(surface), DragTorque(surface)
     return [('gravity gradient', SpaceEnvironment(eccentric, None, [gravity], epoch=30.0)),
             ('dipole', SpaceEnvironment(circular, DipoleField(), [dipole])),
             ('both', SpaceEnvironment(eccentric, DipoleField(rotation_angle=0.4),
                                       [gravity, dipole], epoch=1e4)),
             ('solar pressure', SpaceEnvironment(
                 circular, DipoleField(), [gravity, srp, dipole], epoch=2e3,
-                sun=Sun('2026-03-20T12:00:00Z'), shadow='conical'))]
+                sun=Sun('2026-03-20T12:00:00Z'), shadow='conical')),
+            ('drag', SpaceEnvironment(
+                KeplerOrbit(circular_elements(3e5, 0.9)), None, [drag, srp], epoch=5e3,
+                sun=Sun('2026-03-20T12:00:00Z'), atmosphere=ExponentialAtmosphere(7.29e-5)))]
 
 
-@pytest.mark.parametrize('case', range(4))
+@pytest.mark.parametrize('case', range(5))
 def test_the_stage_statements_give_each_models_own_torque(rng, case):
     """
     The statements the integrators put into their stages give what the models' torque() does.
@@ -201,7 +207,7 @@ def test_the_stage_statements_give_each_models_own_torque(rng, case):
                                    atol=4e-15 * np.linalg.norm(expected))
 
 
-@pytest.mark.parametrize('case', range(4))
+@pytest.mark.parametrize('case', range(5))
 @pytest.mark.parametrize('integrator', ['exact', 'rk4', 'wheels exact', 'wheels rk4'])
 def test_a_step_with_the_environment_in_its_stages_is_the_step_that_calls_the_models(
         case, integrator):
@@ -217,7 +223,8 @@ def test_a_step_with_the_environment_in_its_stages_is_the_step_that_calls_the_mo
     from rigid_body_dynamics.physics.dynamics.gyrostat import GyrostatIntegrator, Wheels
     name, inlined = _environments()[case]
     called = SpaceEnvironment(inlined.orbit, inlined.field, inlined.models, inlined.epoch,
-                              stages=False, sun=inlined.sun, shadow=inlined.shadow)
+                              stages=False, sun=inlined.sun, shadow=inlined.shadow,
+                              atmosphere=inlined.atmosphere)
     q0, w0 = quaternions.normalize(np.array([0.1, 0.2, -0.3, 0.9])), (0.3, -0.5, 0.8)
     wheels = Wheels([c / math.sqrt(3.0) for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
                      for c in g], (0.01,) * 4, coulomb=(1e-4,) * 4, viscous=(1e-6,) * 4)

@@ -275,6 +275,8 @@ def test_an_orbit_under_j2_to_j6_over_topics(launch, probe):
      'solar_pressure needs an orbit (orbit_elements or orbit_tle)'),
     (('-p', 'facets:=[0.01, 0.0, 0.0, 1.0, 0.05, 0.0, 0.0]'),
      'facets must hold 10 numbers per facet'),
+    (('-p', 'drag:=true'), 'drag needs an orbit (orbit_elements or orbit_tle) and facets'),
+    (('-p', 'drag:=true', '-p', 'atmosphere_model:=msis'), 'atmosphere_model must be one of'),
 ])
 def test_bad_environment_parameters_are_refused_at_start_naming_them(launch, args, reason):
     proc = launch(SIM, *args, name='bad_environment')

@@ -11,10 +11,11 @@ that names the parameter.
 
 from .sensor_parameters import epoch_of, sun_from
 from ..engine import Disturbances
-from ..physics.environment import (DipoleField, EARTH_RATE, Facets,
+from ..physics.environment import (DipoleField, EARTH_RATE, ExponentialAtmosphere, Facets,
                                    greenwich_mean_sidereal_time, IGRF13_2020, IgrfField,
                                    julian_date, KeplerOrbit, MU_EARTH, R_EARTH, TleOrbit,
                                    unix_time, ZonalOrbit)
+from ..physics.environment.atmosphere import ATMOSPHERE_MODELS
 from ..physics.environment.facets import FACET_FIELDS
 from ..ros.parameters import ConfigurationError, number_list, Param
 
@@ -92,12 +93,23 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
           'cx, cy, cz (m, body frame, from the centre of mass), specular and diffuse '
           'reflection coefficients (each >= 0, their sum <= 1; the rest is absorbed) and the '
           'drag coefficient. Self-shadowing is not modelled (exact for a convex body). For '
-          'solar_pressure.', read_only=True, convert=number_list('facets')),
+          'solar_pressure and drag.', read_only=True, convert=number_list('facets')),
     Param('solar_pressure', 'bool', False, 'false',
           "The torque of the Sun's light on the facets (Montenbruck and Gill's absorbed, "
           'specular and diffuse parts; 1361 W/m^2 / c at 1 au, scaled by the inverse square '
           "of the Sun's distance and by shadow_model's sunlit fraction), evaluated at every "
           'integrator stage. Needs an orbit, epoch and facets.', read_only=True),
+    Param('drag', 'bool', False, 'false',
+          'The torque of the air on the facets (each facet facing the flow: '
+          '-1/2 rho C_D A (n . v) v, the flat-plate free-molecular model), v the velocity '
+          'relative to the air turning with the Earth (earth_rotation_rate), rho from '
+          'atmosphere_model at the height above the WGS-84 ellipsoid; evaluated at every '
+          'integrator stage. Needs an orbit and facets.', read_only=True),
+    Param('atmosphere_model', 'string', 'exponential', '`exponential`',
+          "The air's density for drag: exponential, Vallado's table 8-4 (Fundamentals of "
+          'Astrodynamics and Applications, 4th ed.; US Standard Atmosphere 1976 and '
+          'CIRA-72), without solar activity (the real density at 400 km moves 5 to 10 '
+          'times over the solar cycle).', choices=ATMOSPHERE_MODELS, read_only=True),
     Param('lvlh_frame', 'string', 'lvlh', '`lvlh`',
           "Frame id of the orbit's LVLH frame (z nadir, y minus the orbit normal), "
           'broadcast as world_frame -> lvlh_frame on /tf with an orbit.', read_only=True),
@@ -208,6 +220,13 @@ def environment_from(out):
                                  f'got {list(out["magnetorquer_max_dipole"])}')
     sun = sun_from(out, orbit) if 'epoch' in out else None
     facets = facets_from(out)
+    if out['drag']:
+        missing = [what for what, absent in (
+            ('an orbit (orbit_elements or orbit_tle)', orbit is None),
+            ('facets (the surface it pushes on)', facets is None)) if absent]
+        if missing:
+            raise ConfigurationError(f'drag needs {" and ".join(missing)}')
+    atmosphere = ExponentialAtmosphere(out['earth_rotation_rate']) if out['drag'] else None
     if out['solar_pressure']:
         missing = [what for what, absent in (
             ('an orbit (orbit_elements or orbit_tle)', orbit is None),
@@ -218,7 +237,7 @@ def environment_from(out):
     return Disturbances(out['disturbance_torque_body'], out['disturbance_torque_world'], orbit,
                         field, out['gravity_gradient'], out['residual_dipole'], sun,
                         out['planet_radius'], out['shadow_model'], facets,
-                        out['solar_pressure'])
+                        out['solar_pressure'], atmosphere, out['drag'])
 
 
 def facets_from(out):

@@ -27,8 +27,8 @@ from .gyrostat import GyrostatIntegrator
 from .integrators import make_integrator
 from .. import quaternions
 from ..environment.space import Disturbances, SpaceEnvironment
-from ..environment.torque_models import (GravityGradient, MagneticDipole, Magnetorquers,
-                                         SolarPressureTorque)
+from ..environment.torque_models import (DragTorque, GravityGradient, MagneticDipole,
+                                         Magnetorquers, SolarPressureTorque)
 from ..quaternions import rotate_components
 
 _ZERO = (0.0, 0.0, 0.0)
@@ -96,10 +96,13 @@ class Plant:
             models.append(magnetorquers)
         if d.solar_pressure:
             models.append(SolarPressureTorque(d.facets.turned(self.principal)))
+        if d.drag:
+            models.append(DragTorque(d.facets.turned(self.principal)))
         # the stepper's time starts at 0 when it is made: the environment is told the offset
         self.field = SpaceEnvironment(
             d.orbit, d.field, models, epoch=(self.steps - self.stepper.steps) * self.dt,
-            sun=d.sun, shadow=d.shadow_model, planet_radius=d.planet_radius) \
+            sun=d.sun, shadow=d.shadow_model, planet_radius=d.planet_radius,
+            atmosphere=d.atmosphere) \
             if models else None
 
     def principal(self, vector):

@@ -11,9 +11,10 @@ gravity gradient, magnetic dipoles, magnetorquers) and :mod:`.space`
 :mod:`.shadow` (the conical shadow with its penumbra); :mod:`.zonal_orbit` (the
 orbit integrated under J2..J6) and :mod:`.chebyshev` (the interpolants both it and
 the IGRF field use along the orbit); :mod:`.facets` (a faceted surface's solar
-radiation pressure and drag).
+radiation pressure and drag) and :mod:`.atmosphere` (the density for drag).
 """
 
+from .atmosphere import ExponentialAtmosphere, geodetic_altitude
 from .facets import Facets, solar_pressure_at
 from .igrf_field import igrf_coefficients, igrf_fixed, IgrfField
 from .magnetic_field import DipoleField, EARTH_RATE, IGRF13_2020, R_REF
@@ -22,11 +23,13 @@ from .shadow import conical_shadow_fraction, R_SUN
 from .space import Disturbances, SpaceEnvironment, Surroundings
 from .sun import in_shadow, julian_date, Sun, sun_direction_almanac, unix_time
 from .tle_orbit import greenwich_mean_sidereal_time, MU_WGS72, TleOrbit
-from .torque_models import GravityGradient, MagneticDipole, Magnetorquers, SolarPressureTorque
+from .torque_models import (DragTorque, GravityGradient, MagneticDipole, Magnetorquers,
+                            SolarPressureTorque)
 from .zonal_orbit import ZonalOrbit
 
 __all__ = ['circular_elements', 'conical_shadow_fraction', 'DipoleField', 'Disturbances',
-           'EARTH_RATE', 'Facets', 'GravityGradient',
+           'DragTorque', 'EARTH_RATE', 'ExponentialAtmosphere', 'Facets', 'geodetic_altitude',
+           'GravityGradient',
            'greenwich_mean_sidereal_time', 'IGRF13_2020', 'igrf_coefficients', 'igrf_fixed',
            'IgrfField', 'in_shadow', 'julian_date',
            'KeplerOrbit', 'lvlh_axes', 'lvlh_quaternion', 'MagneticDipole', 'Magnetorquers',

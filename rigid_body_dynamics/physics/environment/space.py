@@ -31,15 +31,19 @@ class Surroundings:
 
     Also ``r_world`` (m) and ``b_world`` (T); with the Sun, ``s_world`` and ``s_body``
     (the unit direction from the body to the Sun) and ``pressure`` (the solar radiation
-    pressure there, N/m^2, the shadow's fraction included). None where the environment
-    has no orbit, no field or no Sun.
+    pressure there, N/m^2, the shadow's fraction included); with the atmosphere,
+    ``f_world`` and ``f_body`` (the body's velocity relative to the air, m/s) and
+    ``density`` (kg/m^3). None where the environment has no orbit, no field, no Sun
+    or no atmosphere.
     """
 
-    __slots__ = ('r_world', 'r_body', 'b_world', 'b_body', 's_world', 's_body', 'pressure')
+    __slots__ = ('r_world', 'r_body', 'b_world', 'b_body', 's_world', 's_body', 'pressure',
+                 'f_world', 'f_body', 'density')
 
     def __init__(self):
         self.r_world = self.r_body = self.b_world = self.b_body = None
         self.s_world = self.s_body = self.pressure = None
+        self.f_world = self.f_body = self.density = None
 
 
 def _to_body(qx, qy, qz, qw, v):
@@ -67,7 +71,9 @@ class SpaceEnvironment:
     when they have statements (to compare the two). ``sun`` (a
     :class:`~.sun.Sun`), ``shadow`` (a :data:`~.shadow.SHADOW_MODELS` name) and
     ``planet_radius`` (m) give the Sun to models whose ``needs`` has 'sun' (refused
-    without a Sun or an orbit).
+    without a Sun or an orbit); ``atmosphere`` (e.g. an
+    :class:`~.atmosphere.ExponentialAtmosphere`) the air to models whose ``needs`` has
+    'flow' (refused without an atmosphere or an orbit).
 
     Called as ``env(t, qx, qy, qz, qw, wx, wy, wz)`` (t in s, q principal ->
     world, omega rad/s principal) it returns the summed torque (N m, principal).
@@ -79,9 +85,10 @@ class SpaceEnvironment:
     """
 
     def __init__(self, orbit=None, field=None, models=(), epoch=0.0, stages=True, sun=None,
-                 shadow='cylindrical', planet_radius=R_EARTH):
+                 shadow='cylindrical', planet_radius=R_EARTH, atmosphere=None):
         self.orbit, self.field, self.models = orbit, field, tuple(models)
         self.sun, self.shadow, self.planet_radius = sun, shadow, float(planet_radius)
+        self.atmosphere = atmosphere
         needs = set()
         for model in self.models:
             needs |= model.needs
@@ -90,6 +97,12 @@ class SpaceEnvironment:
             if sun is None or orbit is None:
                 raise ValueError('solar radiation pressure needs an orbit and the Sun '
                                  '(orbit_elements or orbit_tle, and epoch)')
+            needs.add('position')
+        self._flow = 'flow' in needs
+        if self._flow:
+            if atmosphere is None or orbit is None:
+                raise ValueError('drag needs an orbit and an atmosphere (orbit_elements or '
+                                 'orbit_tle, and atmosphere_model)')
             needs.add('position')
         if field is not None:
             needs.add('field')
@@ -110,6 +123,10 @@ class SpaceEnvironment:
         self._world = {}
         self._last = (None, None)      # (arguments, torque) of the last call
         #: the models as stage statements (None: one has none; they are then called)
+        # where each world quantity starts in world_at's tuple: r and |r|^2, B, the Sun, the air
+        self._at_b = 4
+        self._at_s = self._at_b + 3 * self._field
+        self._at_f = self._at_s + 4 * self._sun
         self.stage_code = stage_code(self.models, self._position, self._field) if stages \
             else None
         #: the models' constants in the order of ``stage_code.names``, read now
@@ -119,12 +136,14 @@ class SpaceEnvironment:
 
     def world_at(self, t):
         """
-        Return (r (m, 3), norm(r)^2 (m^2), B (T, 3), s (3), P), world frame, at time t (s).
+        Return (r (m), norm(r)^2 (m^2), B (T), s, P, f (m/s), rho), world frame, at time t.
 
-        A flat tuple at integrator time t; r and its norm only when the models need the
-        position, B only with a field, the unit direction s from the body to the Sun
+        A flat tuple at integrator time t (s); r and its norm only when the models need
+        the position, B only with a field, the unit direction s from the body to the Sun
         and the solar radiation pressure P there (N/m^2, times the shadow's sunlit
-        fraction) only when a model needs the Sun (see :class:`~.stage_code.StageCode`).
+        fraction) only when a model needs the Sun, the velocity f relative to the air and
+        the density rho (kg/m^3) only when a model needs the flow (see
+        :class:`~.stage_code.StageCode`).
         """
         world = self._world.get(t)
         if world is None:
@@ -133,12 +152,18 @@ class SpaceEnvironment:
             if len(self._world) > 32:
                 self._world.clear()
             s = t + self.epoch
-            r = self.orbit.position(s)
+            if self._flow:
+                r, v = self.orbit.state(s)
+                r, v = tuple(r), tuple(v)
+            else:
+                r = self.orbit.position(s)
             world = r + (r[0] * r[0] + r[1] * r[1] + r[2] * r[2],)
             if self._field:
                 world += self.field.world(s, r)
             if self._sun:
                 world += self._sunlight(s, r)
+            if self._flow:
+                world += self.atmosphere.flow(r, v) + (self.atmosphere.density(r),)
             world = self._world[t] = world
         return world
 
@@ -158,11 +183,14 @@ class SpaceEnvironment:
             env.r_world = world[:3]
             env.r_body = _to_body(*q, env.r_world)
             if self._field:
-                env.b_world = world[4:7]
+                env.b_world = world[self._at_b:self._at_b + 3]
                 env.b_body = _to_body(*q, env.b_world)
             if self._sun:
-                env.s_world, env.pressure = world[-4:-1], world[-1]
+                env.s_world, env.pressure = world[self._at_s:self._at_s + 3], world[self._at_s + 3]
                 env.s_body = _to_body(*q, env.s_world)
+            if self._flow:
+                env.f_world, env.density = world[self._at_f:self._at_f + 3], world[self._at_f + 3]
+                env.f_body = _to_body(*q, env.f_world)
         return env
 
     def __call__(self, t, qx, qy, qz, qw, wx=0.0, wy=0.0, wz=0.0):
@@ -223,7 +251,9 @@ class Disturbances:
     :class:`~rigid_body_dynamics.physics.sensors.base.Sky`). ``facets`` (a
     :class:`~.facets.Facets`, body frame; None = none) is the body's surface, and
     ``solar_pressure`` the torque of the Sun's light on it (needs the orbit, the Sun
-    and facets).
+    and facets); ``atmosphere`` (e.g. an :class:`~.atmosphere.ExponentialAtmosphere`,
+    None = none) and ``drag`` the torque of the air on the facets (needs the orbit, the
+    atmosphere and facets).
     """
 
     body: tuple = _ZERO
@@ -237,12 +267,14 @@ class Disturbances:
     shadow_model: str = 'cylindrical'
     facets: object = None
     solar_pressure: bool = False
+    atmosphere: object = None
+    drag: bool = False
 
     @property
     def active(self):
         """Whether any disturbance torque acts."""
         return bool(any(self.body) or any(self.world) or self.gravity_gradient
-                    or any(self.residual_dipole) or self.solar_pressure)
+                    or any(self.residual_dipole) or self.solar_pressure or self.drag)
 
     def __str__(self):
         parts = [f'{name} {value}' for name, value in (
@@ -253,4 +285,6 @@ class Disturbances:
         if self.solar_pressure:
             parts.append(f'solar pressure on {len(self.facets)} facets ({self.shadow_model} '
                          'shadow)')
+        if self.drag:
+            parts.append(f'drag on {len(self.facets)} facets ({self.atmosphere})')
         return ', '.join(parts) or 'none'

@@ -24,7 +24,9 @@ A model takes part by a method ``stage_source(prefix)`` returning
 frame, m), ``r_rr`` (its squared norm, m^2), ``b_bx, b_by, b_bz`` (field,
 principal frame, T), ``s_bx, s_by, s_bz`` (the unit direction from the body to the
 Sun, principal frame) and ``s_p`` (the solar radiation pressure there, N/m^2, the
-shadow's fraction included; the model's ``needs`` has 'sun'), ``o_x, o_y, o_z``
+shadow's fraction included; the model's ``needs`` has 'sun'), ``f_bx, f_by, f_bz``
+(the body's velocity relative to the air, principal frame, m/s) and ``f_rho`` (the
+density, kg/m^3; the model's ``needs`` has 'flow'), ``o_x, o_y, o_z``
 (the stage's angular velocity, rad/s, principal frame; the model's ``needs`` has
 'rate'), ``sqrt`` and its constants,
 and set names starting with ``prefix``; ``torque`` three expressions of its torque
@@ -35,7 +37,7 @@ as before: slower, never different.
 """
 
 _STAGE_NAMES = ('r_bx', 'r_by', 'r_bz', 'r_rr', 'b_bx', 'b_by', 'b_bz', 's_bx', 's_by', 's_bz',
-                's_p')
+                's_p', 'f_bx', 'f_by', 'f_bz', 'f_rho')
 
 
 class StageCode:
@@ -43,14 +45,14 @@ class StageCode:
     The statements of an environment's summed torque at one stage, and their constants.
 
     ``models`` (each with ``stage_source``, see the module docstring),
-    ``position``, ``field``, ``rate`` and ``sun``: whether the stages need the
-    position, the field, the angular velocity and the Sun. ``key`` identifies the
+    ``position``, ``field``, ``rate``, ``sun`` and ``flow``: whether the stages need the
+    position, the field, the angular velocity, the Sun and the air. ``key`` identifies the
     generated source (the same key, the same statements: one compiled kernel serves
     every environment of that shape); ``names`` and ``values`` the constants, which
     a kernel unpacks from the environment's ``constants`` at each step.
     """
 
-    def __init__(self, models, position, field, rate=False, sun=False):
+    def __init__(self, models, position, field, rate=False, sun=False, flow=False):
         constants, lines, sums = {}, [], ([], [], [])
         for n, model in enumerate(models):
             prefix = f'm{n}_'
@@ -64,19 +66,20 @@ class StageCode:
             for total, term in zip(sums, torque):
                 total.append(f'({term})')
         self.position, self.field, self.rate = bool(position), bool(field), bool(rate)
-        self.sun = bool(sun)
+        self.sun, self.flow = bool(sun), bool(flow)
         self.names = tuple(constants)
         self.values = tuple(float(v) for v in constants.values())
         self.lines = tuple(lines)
         self.torque = tuple(' + '.join(terms) or '0.0' for terms in sums)
-        self.key = (self.position, self.field, self.rate, self.sun, self.names, self.lines,
-                    self.torque)
+        self.key = (self.position, self.field, self.rate, self.sun, self.flow, self.names,
+                    self.lines, self.torque)
 
     def world_names(self, j):
-        """Names of node j's world quantities: r (m), its squared norm, B (T), the Sun."""
+        """Names of node j's world quantities: r (m), its squared norm, B (T), Sun, air."""
         names = [f'r_wx{j}', f'r_wy{j}', f'r_wz{j}', f'r_rr{j}'] if self.position else []
         names += [f'b_wx{j}', f'b_wy{j}', f'b_wz{j}'] if self.field else []
-        return names + ([f's_wx{j}', f's_wy{j}', f's_wz{j}', f's_pp{j}'] if self.sun else [])
+        names += [f's_wx{j}', f's_wy{j}', f's_wz{j}', f's_pp{j}'] if self.sun else []
+        return names + ([f'f_wx{j}', f'f_wy{j}', f'f_wz{j}', f'f_rr{j}'] if self.flow else [])
 
     def prologue(self, indent='    '):
         """Statements once per step: ``world`` and the constants from the environment ``field``."""
@@ -103,9 +106,10 @@ class StageCode:
         """
         qx, qy, qz, qw = q
         lines = [f'o_x, o_y, o_z = {", ".join(w)}'] if self.rate else []
-        if self.position or self.field or self.sun:
+        if self.position or self.field or self.sun or self.flow:
             lines.append(f's_q = 2.0 / ({qx} * {qx} + {qy} * {qy} + {qz} * {qz} + {qw} * {qw})')
-        for kind, on in (('r', self.position), ('b', self.field), ('s', self.sun)):
+        for kind, on in (('r', self.position), ('b', self.field), ('s', self.sun),
+                         ('f', self.flow)):
             if not on:
                 continue
             vx, vy, vz = f'{kind}_wx{j}', f'{kind}_wy{j}', f'{kind}_wz{j}'
@@ -120,6 +124,8 @@ class StageCode:
             lines.append(f'r_rr = r_rr{j}')
         if self.sun:
             lines.append(f's_p = s_pp{j}')
+        if self.flow:
+            lines.append(f'f_rho = f_rr{j}')
         lines += list(self.lines)
         lines += [f'fx = {self.torque[0]}', f'fy = {self.torque[1]}', f'fz = {self.torque[2]}']
         return [indent + line for line in lines]
@@ -129,8 +135,8 @@ def stage_code(models, position, field):
     """Return the :class:`StageCode` of ``models``, or None when one has no ``stage_source``."""
     if not all(hasattr(model, 'stage_source') for model in models):
         return None
-    return StageCode(models, position, field, any('rate' in model.needs for model in models),
-                     any('sun' in model.needs for model in models))
+    return StageCode(models, position, field, *(any(need in model.needs for model in models)
+                                                for need in ('rate', 'sun', 'flow')))
 
 
 def torque_source(code, name='torque'):

@@ -155,3 +155,44 @@ class SolarPressureTorque:
                 f'{p}ty += {p}a * ({v["cz"]} * s_bx - {v["cx"]} * s_bz) + {p}b * {v["cny"]}',
                 f'{p}tz += {p}a * ({v["cx"]} * s_by - {v["cy"]} * s_bx) + {p}b * {v["cnz"]}']
         return constants, lines, (f'{p}tx', f'{p}ty', f'{p}tz')
+
+
+class DragTorque:
+    """
+    The torque of aerodynamic drag on flat facets (:class:`~.facets.Facets`).
+
+    ``facets`` in the principal frame (``Facets.turned``). At each stage the body's
+    velocity v relative to the air and the density rho come from the environment
+    (``needs`` 'flow'); each facet facing the flow feels
+    F = -1/2 rho C_D A max(0, n . v) v (the flat-plate free-molecular model of
+    :mod:`.facets`, with |v|^2 cos theta v / |v| written as (n . v) v), and the torque
+    is the sum of c x F. As with the Sun's light, a facet's turn into the flow is a
+    kink in the torque.
+    """
+
+    needs = frozenset({'position', 'flow'})
+
+    def __init__(self, facets):
+        self.facets = facets
+
+    def torque(self, t, r, q, omega, env):
+        """Return the sum of c x F over the facets facing the flow (N m, principal frame)."""
+        return tuple(float(c) for c in self.facets.drag_force(env.f_body, env.density)[1])
+
+    def stage_source(self, p):
+        """Return the torque as stage statements (:mod:`.stage_code`): constants, lines, torque."""
+        f = self.facets
+        constants, lines = {}, [f'{p}tx = {p}ty = {p}tz = 0.0']
+        for k in range(len(f)):
+            n, c = f.normal[k], f.centre[k]
+            names = {'nx': n[0], 'ny': n[1], 'nz': n[2], 'cx': c[0], 'cy': c[1], 'cz': c[2],
+                     'k': 0.5 * f.drag[k] * f.area[k]}
+            constants.update({f'{p}{name}{k}': value for name, value in names.items()})
+            v = {name: f'{p}{name}{k}' for name in names}
+            lines += [
+                f'{p}a = -f_rho * {v["k"]} * max(0.0, {v["nx"]} * f_bx + {v["ny"]} * f_by'
+                f' + {v["nz"]} * f_bz)',
+                f'{p}tx += {p}a * ({v["cy"]} * f_bz - {v["cz"]} * f_by)',
+                f'{p}ty += {p}a * ({v["cz"]} * f_bx - {v["cx"]} * f_bz)',
+                f'{p}tz += {p}a * ({v["cx"]} * f_by - {v["cy"]} * f_bx)']
+        return constants, lines, (f'{p}tx', f'{p}ty', f'{p}tz')

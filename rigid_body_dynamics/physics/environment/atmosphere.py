@@ -1,0 +1,99 @@
+"""
+The Earth's atmosphere for drag: the density by altitude, and the air turning with the Earth.
+
+:class:`ExponentialAtmosphere` is the exponential model of Vallado,
+*Fundamentals of Astrodynamics and Applications* (4th ed., 2013), table 8-4
+(from the US Standard Atmosphere 1976 below 25 km and CIRA-72 above): in each
+band of altitude h from its base h0 the density is rho0 exp(-(h - h0) / H),
+the last band's (1000 km) going on above. It holds no solar or geomagnetic
+activity: the real density at 400 km moves by a factor of 5 to 10 over the
+solar cycle, which is why a drag torque is a disturbance to size margins with,
+not a prediction.
+
+The altitude is the height above the WGS-84 ellipsoid (geodetic; at the poles a
+sphere of the equatorial radius would put the body 21 km too high, 40 % too
+little density at 400 km). The air turns with the Earth, so the body meets it
+at v - omega_E x r (world frame, z the rotation axis).
+"""
+
+import math
+
+#: Vallado's table 8-4: (base altitude h0 (km), density there rho0 (kg/m^3), scale height H
+#: (km)) per band, from the band's base to the next one's.
+EXPONENTIAL_TABLE = (
+    (0.0, 1.225, 7.249), (25.0, 3.899e-2, 6.349), (30.0, 1.774e-2, 6.682),
+    (40.0, 3.972e-3, 7.554), (50.0, 1.057e-3, 8.382), (60.0, 3.206e-4, 7.714),
+    (70.0, 8.770e-5, 6.549), (80.0, 1.905e-5, 5.799), (90.0, 3.396e-6, 5.382),
+    (100.0, 5.297e-7, 5.877), (110.0, 9.661e-8, 7.263), (120.0, 2.438e-8, 9.473),
+    (130.0, 8.484e-9, 12.636), (140.0, 3.845e-9, 16.149), (150.0, 2.070e-9, 22.523),
+    (180.0, 5.464e-10, 29.740), (200.0, 2.789e-10, 37.105), (250.0, 7.248e-11, 45.546),
+    (300.0, 2.418e-11, 53.628), (350.0, 9.518e-12, 53.298), (400.0, 3.725e-12, 58.515),
+    (450.0, 1.585e-12, 60.828), (500.0, 6.967e-13, 63.822), (600.0, 1.454e-13, 71.835),
+    (700.0, 3.614e-14, 88.667), (800.0, 1.170e-14, 124.64), (900.0, 5.245e-15, 181.05),
+    (1000.0, 3.019e-15, 268.00))
+
+#: WGS-84's equatorial radius (m) and flattening.
+WGS84_A, WGS84_F = 6378137.0, 1.0 / 298.257223563
+#: The atmosphere models the nodes offer.
+ATMOSPHERE_MODELS = ('exponential',)
+
+
+def geodetic_altitude(r, a=WGS84_A, f=WGS84_F):
+    """
+    Return the height (m) of ``r`` above the ellipsoid (a m, flattening f; WGS-84's).
+
+    ``r`` (m) from the Earth's centre in a frame whose z is the rotation axis (the world
+    frame, or the Earth-fixed one: the height does not depend on the longitude).
+    Bowring's iteration of the geodetic latitude, from his initial guess; within 1e-6 m
+    after three rounds from the surface to the Moon's distance.
+    """
+    x, y, z = r
+    p = math.hypot(x, y)
+    e2 = f * (2.0 - f)
+    b = a * (1.0 - f)
+    ep2 = e2 / (1.0 - e2)
+    beta = math.atan2(a * z, b * p) if p else math.copysign(0.5 * math.pi, z)
+    lat = 0.0
+    for _ in range(3):
+        lat = math.atan2(z + ep2 * b * math.sin(beta) ** 3, p - e2 * a * math.cos(beta) ** 3)
+        beta = math.atan2((1.0 - f) * math.sin(lat), math.cos(lat))
+    s, c = math.sin(lat), math.cos(lat)
+    return p * c + z * s - a * math.sqrt(1.0 - e2 * s * s)
+
+
+class ExponentialAtmosphere:
+    """
+    Vallado's exponential density (see the module) on a rotating Earth.
+
+    ``earth_rate`` (rad/s about the world z axis): the air turns with it. Refuses
+    (ValueError) a non-finite rate.
+    """
+
+    name = 'exponential'
+
+    def __init__(self, earth_rate):
+        self.earth_rate = float(earth_rate)
+        if not math.isfinite(self.earth_rate):
+            raise ValueError(f'the Earth rotation rate must be finite, got {earth_rate!r}')
+        self._bases = [1e3 * h0 for h0, _, _ in EXPONENTIAL_TABLE]
+
+    def density(self, r):
+        """Return rho, the air's density in kg/m^3, at the position ``r`` (m, world frame)."""
+        h = geodetic_altitude(r)
+        k = len(self._bases) - 1
+        while k > 0 and h < self._bases[k]:
+            k -= 1
+        h0, rho0, scale = EXPONENTIAL_TABLE[k]
+        return rho0 * math.exp(-(h - 1e3 * h0) / (1e3 * scale))
+
+    def flow(self, r, v):
+        """
+        Return the body's velocity relative to the air (m/s, world frame): v - omega_E x r.
+
+        ``r`` (m) and ``v`` (m/s), world frame.
+        """
+        w = self.earth_rate
+        return (v[0] + w * r[1], v[1] - w * r[0], v[2])
+
+    def __str__(self):
+        return 'exponential atmosphere (Vallado table 8-4)'
