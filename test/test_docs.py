@@ -284,13 +284,13 @@ def test_the_igrf_comparison_prints_what_the_tle_tutorial_says():
     assert run.stdout == blocks[-1], (run.stdout, blocks[-1])
 
 
-def test_the_solar_pressure_example_prints_what_the_tle_tutorial_says():
-    """doc/examples/solar_pressure.py: its two lines are the tutorial's block after its name."""
-    run = subprocess.run([sys.executable, str(DOC / 'examples' / 'solar_pressure.py')],
+def test_the_surface_torques_example_prints_what_the_tle_tutorial_says():
+    """doc/examples/surface_torques.py: its lines are the tutorial's block after its name."""
+    run = subprocess.run([sys.executable, str(DOC / 'examples' / 'surface_torques.py')],
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, run.stderr
     page = (DOC / 'tutorials' / 'satellite_tle.md').read_text()
-    block = re.search(r'solar_pressure\.py` prints:\n\n```text\n(.*?)^```', page,
+    block = re.search(r'surface_torques\.py` prints:\n\n```text\n(.*?)^```', page,
                       re.S | re.M).group(1)
     assert run.stdout == block, (run.stdout, block)
 

@@ -11,7 +11,7 @@ solar cycle, which is why a drag torque is a disturbance to size margins with,
 not a prediction.
 
 The altitude is the height above the WGS-84 ellipsoid (geodetic; at the poles a
-sphere of the equatorial radius would put the body 21 km too high, 40 % too
+sphere of the equatorial radius would put the body 21 km too high, 30 % too
 little density at 400 km). The air turns with the Earth, so the body meets it
 at v - omega_E x r (world frame, z the rotation axis).
 """

@@ -164,8 +164,8 @@ class DragTorque:
     ``facets`` in the principal frame (``Facets.turned``). At each stage the body's
     velocity v relative to the air and the density rho come from the environment
     (``needs`` 'flow'); each facet facing the flow feels
-    F = -1/2 rho C_D A max(0, n . v) v (the flat-plate free-molecular model of
-    :mod:`.facets`, with |v|^2 cos theta v / |v| written as (n . v) v), and the torque
+    ``F = -1/2 rho C_D A max(0, n . v) v`` (the flat-plate free-molecular model of
+    :mod:`.facets`, with ``|v|^2 cos theta v / |v|`` written as ``(n . v) v``), and the torque
     is the sum of c x F. As with the Sun's light, a facet's turn into the flow is a
     kink in the torque.
     """
