@@ -16,6 +16,7 @@ little density at 400 km). The air turns with the Earth, so the body meets it
 at v - omega_E x r (world frame, z the rotation axis).
 """
 
+from bisect import bisect_right
 import math
 
 #: Vallado's table 8-4: (base altitude h0 (km), density there rho0 (kg/m^3), scale height H
@@ -44,8 +45,9 @@ def geodetic_altitude(r, a=WGS84_A, f=WGS84_F):
 
     ``r`` (m) from the Earth's centre in a frame whose z is the rotation axis (the world
     frame, or the Earth-fixed one: the height does not depend on the longitude).
-    Bowring's iteration of the geodetic latitude, from his initial guess; within 1e-6 m
-    after three rounds from the surface to the Moon's distance.
+    Bowring's formula for the geodetic latitude (Bowring, Survey Review 23, 1976), one
+    round from his initial guess: within 1e-6 m from the surface to the Moon's distance
+    (a second round changes nothing there).
     """
     x, y, z = r
     p = math.hypot(x, y)
@@ -53,10 +55,8 @@ def geodetic_altitude(r, a=WGS84_A, f=WGS84_F):
     b = a * (1.0 - f)
     ep2 = e2 / (1.0 - e2)
     beta = math.atan2(a * z, b * p) if p else math.copysign(0.5 * math.pi, z)
-    lat = 0.0
-    for _ in range(3):
-        lat = math.atan2(z + ep2 * b * math.sin(beta) ** 3, p - e2 * a * math.cos(beta) ** 3)
-        beta = math.atan2((1.0 - f) * math.sin(lat), math.cos(lat))
+    sb, cb = math.sin(beta), math.cos(beta)
+    lat = math.atan2(z + ep2 * b * sb * sb * sb, p - e2 * a * cb * cb * cb)
     s, c = math.sin(lat), math.cos(lat)
     return p * c + z * s - a * math.sqrt(1.0 - e2 * s * s)
 
@@ -80,10 +80,7 @@ class ExponentialAtmosphere:
     def density(self, r):
         """Return rho, the air's density in kg/m^3, at the position ``r`` (m, world frame)."""
         h = geodetic_altitude(r)
-        k = len(self._bases) - 1
-        while k > 0 and h < self._bases[k]:
-            k -= 1
-        h0, rho0, scale = EXPONENTIAL_TABLE[k]
+        h0, rho0, scale = EXPONENTIAL_TABLE[max(0, bisect_right(self._bases, h) - 1)]
         return rho0 * math.exp(-(h - 1e3 * h0) / (1e3 * scale))
 
     def flow(self, r, v):

@@ -46,9 +46,14 @@ def conical_shadow_fraction(r, sun_position, planet_radius, sun_radius=R_SUN):
     if not (body > planet_radius and sun > sun_radius):
         raise ValueError(f'a shadow needs a body outside the planet and the Sun: '
                          f'|r| = {body:g} m, the Sun {sun:g} m away')
+    towards = rx * dx + ry * dy + rz * dz
+    if towards >= 0.0 and planet_radius < 0.9999 * body and sun_radius < 0.01 * sun:
+        # the Sun 90 deg or more from the planet's centre: their discs (together under
+        # 89 deg across) cannot meet; the same answer as below, without the inverse sines
+        return 1.0
     a = math.asin(sun_radius / sun)
     b = math.asin(planet_radius / body)
-    cos_c = -(rx * dx + ry * dy + rz * dz) / (body * sun)
+    cos_c = -towards / (body * sun)
     c = math.acos(max(-1.0, min(1.0, cos_c)))
     if c >= a + b:
         return 1.0

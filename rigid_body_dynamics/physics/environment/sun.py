@@ -93,6 +93,24 @@ def sun_distance_almanac(jd):
     return AU * (1.00014 - 0.01671 * math.cos(g) - 0.00014 * math.cos(2.0 * g))
 
 
+def sun_position_almanac(jd):
+    """
+    Return the Sun's position (m, world frame, from the Earth's centre) at Julian date ``jd``.
+
+    :func:`sun_direction_almanac` times :func:`sun_distance_almanac`, their mean
+    anomaly computed once (the stages ask for it at every distinct time).
+    """
+    d = jd - JD_J2000
+    g = math.radians((357.528 + 0.9856003 * d) % 360.0)
+    sin_g, cos_g = math.sin(g), math.cos(g)
+    lam = math.radians((280.460 + 0.9856474 * d) % 360.0
+                       + 1.915 * sin_g + 0.040 * sin_g * cos_g)
+    eps = math.radians(23.439 - 4e-7 * d)
+    r = AU * (1.00014 - 0.01671 * cos_g - 0.00014 * (2.0 * cos_g * cos_g - 1.0))
+    s = r * math.sin(lam)
+    return (r * math.cos(lam), math.cos(eps) * s, math.sin(eps) * s)
+
+
 class Sun:
     """
     The Sun's direction over simulated time: from ``epoch`` (ISO 8601 UTC), or ``fixed``.
@@ -126,9 +144,9 @@ class Sun:
 
     def position(self, t):
         """Return where the Sun is (m, world, from the Earth's centre) at time t (s)."""
-        s = self.direction(t)
-        d = AU if self.fixed is not None else sun_distance_almanac(self.jd0 + t / _DAY)
-        return (d * s[0], d * s[1], d * s[2])
+        if self.fixed is not None:
+            return (AU * self.fixed[0], AU * self.fixed[1], AU * self.fixed[2])
+        return sun_position_almanac(self.jd0 + t / _DAY)
 
 
 def in_shadow(r, sun, radius):

@@ -135,26 +135,33 @@ class SolarPressureTorque:
         return tuple(float(c) for c in self.facets.solar_pressure(env.s_body, env.pressure)[1])
 
     def stage_source(self, p):
-        """Return the torque as stage statements (:mod:`.stage_code`): constants, lines, torque."""
+        """
+        Return the torque as stage statements (:mod:`.stage_code`): constants, lines, torque.
+
+        Summed as -P (a x s + b) with a = sum (1 - rho_s) A cos c and b = sum 2 A cos
+        (rho_s cos + rho_d / 3) (c x n) over the lit facets, each facet's terms only when
+        it faces the Sun (:func:`_facet_lines`).
+        """
         f = self.facets
-        constants, lines = {}, [f'{p}tx = {p}ty = {p}tz = 0.0']
-        for k in range(len(f)):
+
+        def constants(k):
             n, c = f.normal[k], f.centre[k]
             cn = (c[1] * n[2] - c[2] * n[1], c[2] * n[0] - c[0] * n[2], c[0] * n[1] - c[1] * n[0])
-            names = {'nx': n[0], 'ny': n[1], 'nz': n[2], 'cx': c[0], 'cy': c[1], 'cz': c[2],
-                     'cnx': cn[0], 'cny': cn[1], 'cnz': cn[2],
-                     'ka': f.area[k] * (1.0 - f.specular[k]), 'kb': 2.0 * f.area[k],
-                     'ks': f.specular[k], 'kd': f.diffuse[k] / 3.0}
-            constants.update({f'{p}{name}{k}': value for name, value in names.items()})
-            v = {name: f'{p}{name}{k}' for name in names}
-            lines += [
-                f'{p}c = max(0.0, {v["nx"]} * s_bx + {v["ny"]} * s_by + {v["nz"]} * s_bz)',
-                f'{p}a = -s_p * {v["ka"]} * {p}c',
-                f'{p}b = -s_p * {v["kb"]} * {p}c * ({v["ks"]} * {p}c + {v["kd"]})',
-                f'{p}tx += {p}a * ({v["cy"]} * s_bz - {v["cz"]} * s_by) + {p}b * {v["cnx"]}',
-                f'{p}ty += {p}a * ({v["cz"]} * s_bx - {v["cx"]} * s_bz) + {p}b * {v["cny"]}',
-                f'{p}tz += {p}a * ({v["cx"]} * s_by - {v["cy"]} * s_bx) + {p}b * {v["cnz"]}']
-        return constants, lines, (f'{p}tx', f'{p}ty', f'{p}tz')
+            ka, kb = f.area[k] * (1.0 - f.specular[k]), 2.0 * f.area[k]
+            return {'kx': ka * c[0], 'ky': ka * c[1], 'kz': ka * c[2], 'lx': kb * cn[0],
+                    'ly': kb * cn[1], 'lz': kb * cn[2], 'ks': f.specular[k],
+                    'kd': f.diffuse[k] / 3.0}
+
+        def terms(v):
+            return [f'{p}e = {p}c * ({v["ks"]} * {p}c + {v["kd"]})',
+                    f'{p}ax += {v["kx"]} * {p}c', f'{p}ay += {v["ky"]} * {p}c',
+                    f'{p}az += {v["kz"]} * {p}c', f'{p}bx += {v["lx"]} * {p}e',
+                    f'{p}by += {v["ly"]} * {p}e', f'{p}bz += {v["lz"]} * {p}e']
+        values, lines = _facet_lines(p, f, ('s_bx', 's_by', 's_bz'), constants, terms)
+        lines.insert(0, f'{p}ax = {p}ay = {p}az = {p}bx = {p}by = {p}bz = 0.0')
+        return values, lines, (f'-s_p * ({p}ay * s_bz - {p}az * s_by + {p}bx)',
+                               f'-s_p * ({p}az * s_bx - {p}ax * s_bz + {p}by)',
+                               f'-s_p * ({p}ax * s_by - {p}ay * s_bx + {p}bz)')
 
 
 class DragTorque:
@@ -180,19 +187,57 @@ class DragTorque:
         return tuple(float(c) for c in self.facets.drag_force(env.f_body, env.density)[1])
 
     def stage_source(self, p):
-        """Return the torque as stage statements (:mod:`.stage_code`): constants, lines, torque."""
+        """
+        Return the torque as stage statements (:mod:`.stage_code`): constants, lines, torque.
+
+        Summed as -rho (a x v) with a = sum 1/2 C_D A (n . v) c over the facets facing
+        the flow, each facet's terms only when it does (:func:`_facet_lines`).
+        """
         f = self.facets
-        constants, lines = {}, [f'{p}tx = {p}ty = {p}tz = 0.0']
-        for k in range(len(f)):
-            n, c = f.normal[k], f.centre[k]
-            names = {'nx': n[0], 'ny': n[1], 'nz': n[2], 'cx': c[0], 'cy': c[1], 'cz': c[2],
-                     'k': 0.5 * f.drag[k] * f.area[k]}
-            constants.update({f'{p}{name}{k}': value for name, value in names.items()})
-            v = {name: f'{p}{name}{k}' for name in names}
-            lines += [
-                f'{p}a = -f_rho * {v["k"]} * max(0.0, {v["nx"]} * f_bx + {v["ny"]} * f_by'
-                f' + {v["nz"]} * f_bz)',
-                f'{p}tx += {p}a * ({v["cy"]} * f_bz - {v["cz"]} * f_by)',
-                f'{p}ty += {p}a * ({v["cz"]} * f_bx - {v["cx"]} * f_bz)',
-                f'{p}tz += {p}a * ({v["cx"]} * f_by - {v["cy"]} * f_bx)']
-        return constants, lines, (f'{p}tx', f'{p}ty', f'{p}tz')
+
+        def constants(k):
+            half = 0.5 * f.drag[k] * f.area[k]
+            return {'kx': half * f.centre[k][0], 'ky': half * f.centre[k][1],
+                    'kz': half * f.centre[k][2]}
+
+        def terms(v):
+            return [f'{p}ax += {v["kx"]} * {p}c', f'{p}ay += {v["ky"]} * {p}c',
+                    f'{p}az += {v["kz"]} * {p}c']
+        values, lines = _facet_lines(p, f, ('f_bx', 'f_by', 'f_bz'), constants, terms)
+        lines.insert(0, f'{p}ax = {p}ay = {p}az = 0.0')
+        return values, lines, (f'-f_rho * ({p}ay * f_bz - {p}az * f_by)',
+                               f'-f_rho * ({p}az * f_bx - {p}ax * f_bz)',
+                               f'-f_rho * ({p}ax * f_by - {p}ay * f_bx)')
+
+
+def _facet_lines(p, facets, along, constants, terms):
+    """
+    Return (constants, lines): per facet, ``terms`` when its normal's dot with ``along`` > 0.
+
+    ``along``: the names of the stage's vector (the Sun's direction, the flow);
+    ``constants(k)``: facet k's constants by short name; ``terms(names)``: the
+    statements of a facet facing it, reading ``{p}c`` (the dot) and the facet's
+    constants by those names. Two facets whose normals are exact opposites (a box's
+    faces) share one dot: at most one of them faces the vector.
+    """
+    normals = [tuple(float(c) for c in n) for n in facets.normal]
+    values, lines, done = {}, [], set()
+
+    def names(k):
+        mine = constants(k)
+        values.update({f'{p}{name}{k}': value for name, value in mine.items()})
+        return {name: f'{p}{name}{k}' for name in mine}
+    for k, n in enumerate(normals):
+        if k in done:
+            continue
+        values.update({f'{p}nx{k}': n[0], f'{p}ny{k}': n[1], f'{p}nz{k}': n[2]})
+        lines.append(f'{p}c = {p}nx{k} * {along[0]} + {p}ny{k} * {along[1]} + '
+                     f'{p}nz{k} * {along[2]}')
+        lines += [f'if {p}c > 0.0:'] + ['    ' + line for line in terms(names(k))]
+        back = next((j for j in range(k + 1, len(normals)) if j not in done
+                     and normals[j] == (-n[0], -n[1], -n[2])), None)
+        if back is not None:
+            done.add(back)
+            lines += [f'elif {p}c < 0.0:', f'    {p}c = -{p}c']
+            lines += ['    ' + line for line in terms(names(back))]
+    return values, lines
