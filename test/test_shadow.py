@@ -100,6 +100,41 @@ def test_full_sunlight_and_umbra_agree_with_the_cylinder_away_from_the_edge():
     assert conical_shadow_fraction(side, sun, R_EARTH) == 1.0
 
 
+def test_on_the_sunward_side_the_discs_never_meet():
+    """
+    Where the Sun is 90 deg or more from the Earth's centre, the fraction is 1 at once.
+
+    At 2000 random places with r . (sun - r) >= 0 from 100 km to 40 000 km up, many just
+    on the terminator's plane: the angle between the two discs' centres, computed here,
+    exceeds the sum of their angular radii, so the whole Sun shows.
+    """
+    rng = np.random.default_rng(8)
+    sun = np.array([AU, 0.0, 0.0])
+    for _ in range(2000):
+        u = rng.normal(size=3)
+        u /= np.linalg.norm(u)
+        u[0] = abs(u[0]) * rng.choice([1e-9, 1e-3, 1.0])
+        r = (R_EARTH + rng.uniform(1e5, 4e7)) * u / np.linalg.norm(u)
+        d = sun - r
+        if r @ d < 0.0:
+            continue
+        apart = math.acos(np.clip(-(r @ d) / (np.linalg.norm(r) * np.linalg.norm(d)), -1, 1))
+        assert apart > math.asin(R_SUN / np.linalg.norm(d)) + math.asin(R_EARTH /
+                                                                        np.linalg.norm(r))
+        assert conical_shadow_fraction(r, sun, R_EARTH) == 1.0
+
+
+def test_the_suns_position_is_its_direction_times_its_distance():
+    """sun_position_almanac (one evaluation) against the two formulas, 1950-2050, to 1e-15."""
+    from rigid_body_dynamics.physics.environment.sun import (sun_direction_almanac,
+                                                             sun_position_almanac)
+    for jd in np.linspace(julian_date('1950-01-01T00:00:00Z'),
+                          julian_date('2050-01-01T00:00:00Z'), 2001):
+        expected = np.array(sun_direction_almanac(jd)) * sun_distance_almanac(jd)
+        got = np.array(sun_position_almanac(jd))
+        assert np.linalg.norm(got - expected) < 1e-15 * np.linalg.norm(expected), jd
+
+
 def test_the_fraction_rises_monotonically_across_the_edge_in_about_eight_seconds():
     # a circular 400 km orbit in the ecliptic's plane with the Sun along x: the exit
     # from the shadow, sampled every 10 ms
