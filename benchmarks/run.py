@@ -19,6 +19,7 @@ run now are replaced.
 import argparse
 import os
 import re
+import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -227,6 +228,9 @@ def write(sections):
         f.write(text)
     print(f'wrote {RESULTS}')
     print(text)
+    # The manual's pages generated from RESULTS.md (the benchmarks index, the discovery
+    # table) follow it at once: a rewritten RESULTS.md never leaves them stale.
+    subprocess.run([sys.executable, os.path.join(HERE, '..', 'doc', 'generate.py')], check=True)
 
 
 if __name__ == '__main__':
