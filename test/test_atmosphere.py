@@ -49,7 +49,7 @@ def test_the_density_is_vallados_band_at_that_height(h, base):
     expected = rho0 * math.exp(-(h - base) / scale)
     air = ExponentialAtmosphere(7.292115e-5)
     for lat in (0.0, math.pi / 2):
-        assert air.density(_position(lat, 1.0, 1e3 * h)) == pytest.approx(expected, rel=1e-12)
+        assert air.density(0.0, _position(lat, 1.0, 1e3 * h)) == pytest.approx(expected, rel=1e-12)
 
 
 def test_the_bands_meet_within_a_ten_thousandth_above_25_km():
@@ -57,7 +57,7 @@ def test_the_bands_meet_within_a_ten_thousandth_above_25_km():
     from rigid_body_dynamics.physics.environment.atmosphere import EXPONENTIAL_TABLE
     air = ExponentialAtmosphere(0.0)
     for h0, _, _ in EXPONENTIAL_TABLE[2:]:
-        below, above = (air.density((A + 1e3 * h0 + d, 0.0, 0.0)) for d in (-1e-3, 1e-3))
+        below, above = (air.density(0.0, (A + 1e3 * h0 + d, 0.0, 0.0)) for d in (-1e-3, 1e-3))
         assert above == pytest.approx(below, rel=1e-4), h0
 
 

@@ -277,6 +277,10 @@ def test_an_orbit_under_j2_to_j6_over_topics(launch, probe):
      'facets must hold 10 numbers per facet'),
     (('-p', 'drag:=true'), 'drag needs an orbit (orbit_elements or orbit_tle) and facets'),
     (('-p', 'drag:=true', '-p', 'atmosphere_model:=msis'), 'atmosphere_model must be one of'),
+    (('-p', 'orbit_elements:=[7.0e6, 0.0, 0.0, 0.0, 0.0, 0.0]', '-p', 'drag:=true', '-p',
+      'facets:=[0.01, 0.0, 0.0, 1.0, 0.05, 0.0, 0.0, 0.3, 0.2, 2.2]', '-p',
+      'atmosphere_model:=nrlmsis'), 'atmosphere_model nrlmsis needs epoch'),
+    (('-p', 'solar_flux_f107:=0.0'), 'solar_flux_f107'),
 ])
 def test_bad_environment_parameters_are_refused_at_start_naming_them(launch, args, reason):
     proc = launch(SIM, *args, name='bad_environment')

@@ -13,8 +13,8 @@ from .sensor_parameters import epoch_of, sun_from
 from ..engine import Disturbances
 from ..physics.environment import (DipoleField, EARTH_RATE, ExponentialAtmosphere, Facets,
                                    greenwich_mean_sidereal_time, IGRF13_2020, IgrfField,
-                                   julian_date, KeplerOrbit, MU_EARTH, R_EARTH, TleOrbit,
-                                   unix_time, ZonalOrbit)
+                                   julian_date, KeplerOrbit, MsisAtmosphere, MU_EARTH,
+                                   R_EARTH, TleOrbit, unix_time, ZonalOrbit)
 from ..physics.environment.atmosphere import ATMOSPHERE_MODELS
 from ..physics.environment.facets import FACET_FIELDS
 from ..ros.parameters import ConfigurationError, number_list, Param
@@ -109,7 +109,20 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
           "The air's density for drag: exponential, Vallado's table 8-4 (Fundamentals of "
           'Astrodynamics and Applications, 4th ed.; US Standard Atmosphere 1976 and '
           'CIRA-72), without solar activity (the real density at 400 km moves 5 to 10 '
-          'times over the solar cycle).', choices=ATMOSPHERE_MODELS, read_only=True),
+          'times over the solar cycle); or nrlmsis, NRLMSIS 2.1 (the pymsis library) at '
+          "the epoch's date with solar_flux_f107, solar_flux_f107a and geomagnetic_ap, "
+          'interpolated along the orbit within 1e-5 of the model (needs an epoch).',
+          choices=ATMOSPHERE_MODELS, read_only=True),
+    Param('solar_flux_f107', 'double', 150.0, '150.0 sfu',
+          "The previous day's 10.7 cm solar radio flux F10.7 (solar flux units, 1e-22 "
+          'W m^-2 Hz^-1) for atmosphere_model nrlmsis: 70 at solar minimum, 150 moderate, '
+          '250 and more at maximum.', low=1.0, high=1000.0, read_only=True),
+    Param('solar_flux_f107a', 'double', 150.0, '150.0 sfu',
+          'The 81-day mean of F10.7 (sfu) centred on the date, for atmosphere_model nrlmsis.',
+          low=1.0, high=1000.0, read_only=True),
+    Param('geomagnetic_ap', 'double', 4.0, '4.0',
+          'The daily geomagnetic index Ap for atmosphere_model nrlmsis: 4 quiet, 15 to 30 '
+          'active, 100 and more a storm.', low=0.0, high=400.0, read_only=True),
     Param('lvlh_frame', 'string', 'lvlh', '`lvlh`',
           "Frame id of the orbit's LVLH frame (z nadir, y minus the orbit normal), "
           'broadcast as world_frame -> lvlh_frame on /tf with an orbit.', read_only=True),
@@ -226,7 +239,7 @@ def environment_from(out):
             ('facets (the surface it pushes on)', facets is None)) if absent]
         if missing:
             raise ConfigurationError(f'drag needs {" and ".join(missing)}')
-    atmosphere = ExponentialAtmosphere(out['earth_rotation_rate']) if out['drag'] else None
+    atmosphere = atmosphere_from(out, orbit) if out['drag'] else None
     if out['solar_pressure']:
         missing = [what for what, absent in (
             ('an orbit (orbit_elements or orbit_tle)', orbit is None),
@@ -238,6 +251,27 @@ def environment_from(out):
                         field, out['gravity_gradient'], out['residual_dipole'], sun,
                         out['planet_radius'], out['shadow_model'], facets,
                         out['solar_pressure'], atmosphere, out['drag'])
+
+
+def atmosphere_from(out, orbit):
+    """
+    Return the atmosphere of validated values ``out`` on ``orbit`` (refusing with the reason).
+
+    ``exponential``: Vallado's table; ``nrlmsis``: NRLMSIS 2.1 along the orbit from the
+    epoch's date, with the solar and geomagnetic activity, the Earth turned as for the field.
+    """
+    if out['atmosphere_model'] == 'exponential':
+        return ExponentialAtmosphere(out['earth_rotation_rate'])
+    epoch = epoch_of(out, orbit)
+    if not epoch:
+        raise ConfigurationError("atmosphere_model nrlmsis needs epoch (the date of the air's "
+                                 'season and local time)')
+    try:
+        return MsisAtmosphere(orbit, unix_time(epoch), out['solar_flux_f107'],
+                              out['solar_flux_f107a'], out['geomagnetic_ap'],
+                              earth_rotation_angle(out, orbit), out['earth_rotation_rate'])
+    except ValueError as err:
+        raise ConfigurationError(str(err)) from None
 
 
 def facets_from(out):

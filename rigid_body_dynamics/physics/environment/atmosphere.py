@@ -36,7 +36,7 @@ EXPONENTIAL_TABLE = (
 #: WGS-84's equatorial radius (m) and flattening.
 WGS84_A, WGS84_F = 6378137.0, 1.0 / 298.257223563
 #: The atmosphere models the nodes offer.
-ATMOSPHERE_MODELS = ('exponential',)
+ATMOSPHERE_MODELS = ('exponential', 'nrlmsis')
 
 
 def geodetic_altitude(r, a=WGS84_A, f=WGS84_F):
@@ -49,6 +49,16 @@ def geodetic_altitude(r, a=WGS84_A, f=WGS84_F):
     round from his initial guess: within 1e-6 m from the surface to the Moon's distance
     (a second round changes nothing there).
     """
+    return geodetic_latitude_height(r, a, f)[1]
+
+
+def geodetic_latitude_height(r, a=WGS84_A, f=WGS84_F):
+    """
+    Return (geodetic latitude (rad), height (m)) of ``r`` over the ellipsoid (a m, flattening f).
+
+    ``r`` (m) from the Earth's centre, z the rotation axis; Bowring's one round, as
+    :func:`geodetic_altitude`.
+    """
     x, y, z = r
     p = math.hypot(x, y)
     e2 = f * (2.0 - f)
@@ -58,7 +68,17 @@ def geodetic_altitude(r, a=WGS84_A, f=WGS84_F):
     sb, cb = math.sin(beta), math.cos(beta)
     lat = math.atan2(z + ep2 * b * sb * sb * sb, p - e2 * a * cb * cb * cb)
     s, c = math.sin(lat), math.cos(lat)
-    return p * c + z * s - a * math.sqrt(1.0 - e2 * s * s)
+    return lat, p * c + z * s - a * math.sqrt(1.0 - e2 * s * s)
+
+
+def air_flow(earth_rate, r, v):
+    """
+    Return the velocity (m/s, world frame) relative to the air turning with the Earth.
+
+    That is v - omega x r, omega ``earth_rate`` (rad/s) about the world z axis, ``r``
+    (m) and ``v`` (m/s) in the world frame.
+    """
+    return (v[0] + earth_rate * r[1], v[1] - earth_rate * r[0], v[2])
 
 
 class ExponentialAtmosphere:
@@ -77,8 +97,12 @@ class ExponentialAtmosphere:
             raise ValueError(f'the Earth rotation rate must be finite, got {earth_rate!r}')
         self._bases = [1e3 * h0 for h0, _, _ in EXPONENTIAL_TABLE]
 
-    def density(self, r):
-        """Return rho, the air's density in kg/m^3, at the position ``r`` (m, world frame)."""
+    def density(self, t, r):
+        """
+        Return rho, the air's density in kg/m^3, at the position ``r`` (m, world frame).
+
+        ``t`` (s, orbit time) is not used: the table holds no time.
+        """
         h = geodetic_altitude(r)
         h0, rho0, scale = EXPONENTIAL_TABLE[max(0, bisect_right(self._bases, h) - 1)]
         return rho0 * math.exp(-(h - 1e3 * h0) / (1e3 * scale))
@@ -89,8 +113,7 @@ class ExponentialAtmosphere:
 
         ``r`` (m) and ``v`` (m/s), world frame.
         """
-        w = self.earth_rate
-        return (v[0] + w * r[1], v[1] - w * r[0], v[2])
+        return air_flow(self.earth_rate, r, v)
 
     def __str__(self):
         return 'exponential atmosphere (Vallado table 8-4)'

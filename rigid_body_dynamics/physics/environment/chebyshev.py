@@ -2,9 +2,10 @@
 A vector function of time interpolated on segments by Chebyshev polynomials (no ROS).
 
 Used where a quantity along the orbit is dear to evaluate and smooth in time (the
-IGRF field, the integrated orbit) but is asked for at every integrator stage: the
-time axis is cut into segments of ``span`` s; on segment k = floor(t / span) the
-three components are each a polynomial of degree ``order`` in
+IGRF field, the integrated orbit, the NRLMSIS density) but is asked for at every
+integrator stage: the time axis is cut into segments of ``span`` s; on segment
+k = floor(t / span) the components (three, or ``components``) are each a polynomial
+of degree ``order`` in
 x = (t - middle) / half-width, interpolating the function at the Chebyshev points
 of the first kind (Trefethen, Approximation Theory and Approximation Practice,
 chapter 4). A segment is built the first time it is asked for and kept (the last
@@ -20,25 +21,31 @@ from ..dynamics.rk_kernels import compile_source
 
 class ChebyshevSegments:
     """
-    ``sample(middle, times)`` -> (order + 1, 3) values interpolated on segments of ``span`` s.
+    ``sample(middle, times)`` -> (order + 1, n) values interpolated on segments of ``span`` s.
 
     ``sample`` gets the segment's middle (s) and its order + 1 Chebyshev nodes
-    ``times`` (s, an array) and returns the function's three components there (any
-    unit: the interpolant has the same). :attr:`value` (t s) is the interpolant at t,
-    a 3-tuple (compiled: what a stage calls). ``keep``: segments kept before the cache is emptied.
+    ``times`` (s, an array) and returns the function's n = ``components`` components
+    there (any unit: the interpolant has the same). :attr:`value` (t s) is the
+    interpolant at t, an n-tuple, or a float when n is 1 (compiled: what a stage
+    calls). ``keep``: segments kept before the cache is emptied. ``origin`` (s): a
+    time where segments meet (segment k is origin + [k, k + 1) span), so that a step
+    of the function there falls between two.
     """
 
-    def __init__(self, sample, span, order, keep=16, name='chebyshev'):
+    def __init__(self, sample, span, order, keep=16, name='chebyshev', components=3,
+                 origin=0.0):
         if not (math.isfinite(span) and span > 0.0):
             raise ValueError(f'the segment length must be positive and finite, got {span!r} s')
         self.sample, self.span, self.order, self.keep = sample, float(span), int(order), keep
+        self.origin = math.fmod(float(origin), self.span)
         self._nodes = np.cos(math.pi * (np.arange(order + 1) + 0.5) / (order + 1))
         # the monomials in x of the interpolant at the nodes: coefficients = fit @ values
         self._fit = np.linalg.inv(np.vander(self._nodes, order + 1, increasing=True))
         self._segments = {}
-        self.value = compile_source(horner_source(order), f'<{name} horner {order}>', {
+        self.value = compile_source(horner_source(order, components),
+                                    f'<{name} horner {order}>', {
             'segments': self._segments, 'build': self.segment, 'floor': math.floor,
-            'inverse_span': 1.0 / self.span})
+            'inverse_span': 1.0 / self.span, 'origin': self.origin})
 
     def segment(self, k):
         """
@@ -50,23 +57,27 @@ class ChebyshevSegments:
         found = self._segments.get(k)
         if found is None:
             half = 0.5 * self.span
-            middle = (k + 0.5) * self.span
+            middle = self.origin + (k + 0.5) * self.span
             values = np.asarray(self.sample(middle, middle + half * self._nodes), float)
-            coefficients = (self._fit @ values).T               # (3, order + 1), x^0 first
+            values = values.reshape(self.order + 1, -1)
+            coefficients = (self._fit @ values).T               # (n, order + 1), x^0 first
             if len(self._segments) > self.keep:
                 self._segments.clear()
             found = self._segments[k] = (middle, 1.0 / half, *coefficients.ravel().tolist())
         return found
 
 
-def horner_source(order):
+def horner_source(order, components=3):
     """
     Source of ``value(t)``: the segment of t's interpolant by Horner's rule, unrolled.
 
     Its names: ``segments`` (the dict of segments), ``build`` (makes a missing one),
-    ``floor`` and ``inverse_span`` (1 / segment length, 1/s).
+    ``floor``, ``inverse_span`` (1 / segment length, 1/s) and ``origin`` (s, where
+    segments meet). It returns a
+    ``components``-tuple, or a float for one component.
     """
-    names = [f'{c}{j}' for c in 'abc' for j in range(order + 1)]
+    letters = 'abcdefgh'[:components]
+    names = [f'{c}{j}' for c in letters for j in range(order + 1)]
 
     def horner(c):
         text = f'{c}{order}'
@@ -75,12 +86,12 @@ def horner_source(order):
         return text
     return '\n'.join([
         'def value(t):',
-        '    k = floor(t * inverse_span)',
+        '    k = floor((t - origin) * inverse_span)',
         '    found = segments.get(k)',
         '    if found is None:',
         '        found = build(k)',
         f'    middle, inverse_half, {", ".join(names)} = found',
         '    x = (t - middle) * inverse_half',
-        f'    return ({horner("a")},',
-        f'            {horner("b")},',
-        f'            {horner("c")})', ''])
+        '    return ' + (horner('a') if components == 1 else
+                         '(' + ',\n            '.join(horner(c) for c in letters) + ')'),
+        ''])

@@ -163,7 +163,7 @@ class SpaceEnvironment:
             if self._sun:
                 world += self._sunlight(s, r)
             if self._flow:
-                world += self.atmosphere.flow(r, v) + (self.atmosphere.density(r),)
+                world += self.atmosphere.flow(r, v) + (self.atmosphere.density(s, r),)
             world = self._world[t] = world
         return world
 
