@@ -39,6 +39,7 @@ NO_KEY = {
     'allantools': "tests only: the reference for the report's Allan deviation (pip)",
     'sgp4': 'orbit_tle only; optional.require names it when missing (apt python3-sgp4)',
     'ppigrf': 'magnetic_field_model igrf only; optional.require names it when missing (pip)',
+    'pymsis': 'atmosphere_model nrlmsis only; optional.require names it when missing (pip)',
 }
 #: Declared, though no Python file imports them (and where they are used).
 NOT_IMPORTED = {

@@ -13,6 +13,7 @@ turning with the Earth, and the refusals.
 
 from datetime import datetime, timezone
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -149,3 +150,10 @@ def test_bad_activity_is_refused_naming_it(kwargs, match):
     settings = {'orbit': KeplerOrbit(ORBITS[0]), 'start': START, **kwargs}
     with pytest.raises(ValueError, match=match):
         MsisAtmosphere(**settings)
+
+
+def test_without_pymsis_the_model_is_refused_saying_what_to_install(monkeypatch):
+    monkeypatch.setitem(sys.modules, 'pymsis', None)
+    with pytest.raises(ValueError, match='atmosphere_model nrlmsis needs the pymsis library: '
+                       'pymsis is not installed; install with pip install pymsis'):
+        MsisAtmosphere(KeplerOrbit(ORBITS[0]), START)

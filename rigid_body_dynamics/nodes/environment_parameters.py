@@ -111,7 +111,8 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
           'CIRA-72), without solar activity (the real density at 400 km moves 5 to 10 '
           'times over the solar cycle); or nrlmsis, NRLMSIS 2.1 (the pymsis library) at '
           "the epoch's date with solar_flux_f107, solar_flux_f107a and geomagnetic_ap, "
-          'interpolated along the orbit within 1e-5 of the model (needs an epoch).',
+          'interpolated along the orbit within 1.5e-4 of the model, which computes in single '
+          'precision (needs an epoch).',
           choices=ATMOSPHERE_MODELS, read_only=True),
     Param('solar_flux_f107', 'double', 150.0, '150.0 sfu',
           "The previous day's 10.7 cm solar radio flux F10.7 (solar flux units, 1e-22 "
