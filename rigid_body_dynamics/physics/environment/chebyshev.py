@@ -73,8 +73,7 @@ def horner_source(order, components=3):
 
     Its names: ``segments`` (the dict of segments), ``build`` (makes a missing one),
     ``floor``, ``inverse_span`` (1 / segment length, 1/s) and ``origin`` (s, where
-    segments meet). It returns a
-    ``components``-tuple, or a float for one component.
+    segments meet). It returns a ``components``-tuple, or a float for one component.
     """
     letters = 'abcdefgh'[:components]
     names = [f'{c}{j}' for c in letters for j in range(order + 1)]
