@@ -25,10 +25,11 @@ the time of day from 0 h, so its density steps at 0 h UTC (by 0.2 to 0.7 % on
 the days measured); the segments meet there, so that the step falls between two
 and neither is bent by it. The model computes in single precision (``pymsis``
 returns float32) and its density is noisy at a few 1e-5 from one call to the
-next; the default 16 segments of degree 9 follow it to within that noise: ``test_msis_atmosphere`` holds the interpolant to
-1.5e-4 of the model at 600 times from 250 to 1000 km (the worst over twelve
-draws 8.4e-5; 32 segments are no closer), far inside the model's own error
-against measured densities (of the order of ten percent).
+next; the default 16 segments of degree 9 follow it to within that noise:
+``test_msis_atmosphere`` holds the interpolant to 1.5e-4 of the model at 600
+times from 250 to 1000 km (the worst over twelve draws 8.4e-5; 32 segments are
+no closer), far inside the model's own error against measured densities (of the
+order of ten percent).
 """
 
 import math
