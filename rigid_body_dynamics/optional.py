@@ -49,3 +49,16 @@ def require(*modules):
         verb = 'is' if len(missing) == 1 else 'are'
         raise MissingDependency(f'{" and ".join(missing)} {verb} not installed; install with '
                                 + '; '.join(how))
+
+
+def require_for(setting, module):
+    """
+    Check that ``module`` imports, for a parameter's ``setting`` (e.g. 'orbit_tle').
+
+    Else raise ValueError naming the setting and what to install, in one line: the node
+    that validates the setting refuses it with that reason.
+    """
+    try:
+        require(module)
+    except MissingDependency as err:
+        raise ValueError(f'{setting} needs the {module} library: {err}') from None

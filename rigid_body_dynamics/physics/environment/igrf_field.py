@@ -39,7 +39,7 @@ import math
 import numpy as np
 
 from .chebyshev import ChebyshevSegments
-from ...optional import MissingDependency, require
+from ...optional import require_for
 
 #: The IGRF reference radius (m), the same as the dipole's.
 R_REF = 6371200.0
@@ -48,10 +48,7 @@ _SHC = {}
 
 def _library():
     """Return ppigrf's module of its functions (ValueError naming the parameter if missing)."""
-    try:
-        require('ppigrf')
-    except MissingDependency as err:
-        raise ValueError(f'magnetic_field_model igrf needs the ppigrf library: {err}') from None
+    require_for('magnetic_field_model igrf', 'ppigrf')
     from ppigrf import ppigrf
     return ppigrf
 

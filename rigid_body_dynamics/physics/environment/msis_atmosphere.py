@@ -38,22 +38,12 @@ import numpy as np
 
 from .atmosphere import air_flow, geodetic_latitude_height
 from .chebyshev import ChebyshevSegments
-from ...optional import MissingDependency, require
+from ...optional import require_for
 
 #: NRLMSIS's version that ``pymsis`` evaluates.
 MSIS_VERSION = 2.1
 #: A day (s): the model's day of the year changes at every multiple from 1970.
 DAY = 86400.0
-
-
-def _library():
-    """Return pymsis's ``calculate`` (ValueError naming the parameter if missing)."""
-    try:
-        require('pymsis')
-    except MissingDependency as err:
-        raise ValueError(f'atmosphere_model nrlmsis needs the pymsis library: {err}') from None
-    from pymsis import calculate
-    return calculate
 
 
 class MsisAtmosphere:
@@ -73,7 +63,9 @@ class MsisAtmosphere:
 
     def __init__(self, orbit, start, f107=150.0, f107a=150.0, ap=4.0, rotation_angle=0.0,
                  rotation_rate=0.0, segments=16, order=9):
-        self._calculate = _library()
+        require_for('atmosphere_model nrlmsis', 'pymsis')
+        from pymsis import calculate
+        self._calculate = calculate
         for key, value in (('solar_flux_f107', f107), ('solar_flux_f107a', f107a)):
             if not (math.isfinite(value) and 0.0 < value <= 1000.0):
                 raise ValueError(f'{key} must be in (0, 1000] sfu, got {value!r}')

@@ -26,7 +26,7 @@ from datetime import datetime, timezone
 import math
 
 from .sun import JD_UNIX, unix_time
-from ...optional import MissingDependency, require
+from ...optional import require_for
 
 #: WGS-72's gravitational parameter (m^3/s^2), the one SGP4 flies TLEs with.
 MU_WGS72 = 3.986008e14
@@ -49,10 +49,7 @@ def greenwich_mean_sidereal_time(jd_ut1):
 
 def _satrec(line1, line2):
     """Return sgp4's Satrec of the two lines; ValueError naming ``orbit_tle`` says why not."""
-    try:
-        require('sgp4')
-    except MissingDependency as err:
-        raise ValueError(f'orbit_tle needs the sgp4 library: {err}') from None
+    require_for('orbit_tle', 'sgp4')
     from sgp4.api import Satrec, WGS72
     lines = []
     for number, line in ((1, line1), (2, line2)):
