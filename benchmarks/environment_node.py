@@ -9,8 +9,9 @@ at 10 Hz (every stage evaluates the orbit, the field and the torques); the engin
 also with the IGRF-14 to degree 13 instead of the dipole (interpolated along the orbit), on
 the Kepler orbit and on the ISS's TLE (SGP4, epoch 2019-12-09T20:42:00Z); and the whole
 mission model: the orbit integrated under J2, the IGRF-14 to degree 13, the gravity
-gradient, the residual dipole, and drag (Vallado's exponential air) and solar pressure
-(the Almanac's Sun from the epoch, the conical shadow) on a 3U CubeSat's six faces. CPU is the
+gradient, the residual dipole, and drag (Vallado's exponential air, and again NRLMSIS 2.1's
+at F10.7 150, Ap 4) and solar pressure (the Almanac's Sun from the epoch, the conical
+shadow) on a 3U CubeSat's six faces. CPU is the
 simulator's share of one core over 8 s after 3 s of warm-up, each case three times,
 alternating. Then the engine's step alone (``BodySimulation.advance`` on a fake clock, the
 least of three runs of 20000 steps), free, under a constant torque, and in the same
@@ -32,7 +33,8 @@ from rigid_body_dynamics.physics import Inertia
 from rigid_body_dynamics.physics.dynamics.gyrostat import Wheels
 from rigid_body_dynamics.physics.environment import (DipoleField, EARTH_RATE,
                                                      ExponentialAtmosphere, Facets, IgrfField,
-                                                     KeplerOrbit, SpaceEnvironment, Sun,
+                                                     KeplerOrbit, MsisAtmosphere,
+                                                     SpaceEnvironment, Sun,
                                                      TleOrbit, unix_time, ZonalOrbit)
 from rigid_body_dynamics.physics.environment.facets import box
 
@@ -45,6 +47,7 @@ ISS = ('1 25544U 98067A   19343.69339541  .00001764  00000-0  38792-4 0  9991',
 EPOCH = '2019-12-09T20:42:00Z'
 MISSION = ('J2 orbit, IGRF-14 to degree 13, gravity gradient, residual dipole, drag, solar '
            'pressure')
+MISSION_MSIS = f'{MISSION}, the air NRLMSIS 2.1'
 
 
 def measure():
@@ -103,11 +106,15 @@ def engine_steps(steps=20000):
         orbit=tle, field=IgrfField(tle, unix_time(EPOCH), 13, 0.0, EARTH_RATE),
         gravity_gradient=True, residual_dipole=(0.01, -0.02, 0.005))
     zonal = ZonalOrbit([6878137.0, 0.0, 1.0, 0.3, 0.0, 0.0], 2)
-    cases[MISSION] = Disturbances(
-        orbit=zonal, field=IgrfField(zonal, unix_time(EPOCH), 13, 0.0, EARTH_RATE),
-        gravity_gradient=True, residual_dipole=(0.01, -0.02, 0.005), sun=Sun(EPOCH),
-        shadow_model='conical', facets=Facets(box((0.1, 0.1, 0.34), (0.0, 0.0, 0.02), 0.3, 0.1)),
-        solar_pressure=True, atmosphere=ExponentialAtmosphere(EARTH_RATE), drag=True)
+    for name, air in ((MISSION, ExponentialAtmosphere(EARTH_RATE)),
+                      (MISSION_MSIS, MsisAtmosphere(zonal, unix_time(EPOCH), 150.0, 150.0, 4.0,
+                                                    0.0, EARTH_RATE))):
+        cases[name] = Disturbances(
+            orbit=zonal, field=IgrfField(zonal, unix_time(EPOCH), 13, 0.0, EARTH_RATE),
+            gravity_gradient=True, residual_dipole=(0.01, -0.02, 0.005), sun=Sun(EPOCH),
+            shadow_model='conical',
+            facets=Facets(box((0.1, 0.1, 0.34), (0.0, 0.0, 0.02), 0.3, 0.1)),
+            solar_pressure=True, atmosphere=air, drag=True)
     pyramid = [c / 3 ** 0.5 for g in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1)) for c in g]
     wheels = Wheels(pyramid, (0.01,) * 4, coulomb=(1e-4,) * 4, viscous=(1e-6,) * 4)
     lines = ['| engine step (1 ms, I = (2, 3, 1.2) kg m^2) | wheels | us per step, models in '
@@ -128,12 +135,13 @@ def engine_steps(steps=20000):
     ratios = [(name, found[name, False][False] / torqued, found[name, False][True] / torqued)
               for name in list(cases)[2:]]
     dipole = found['gravity gradient, field, residual dipole', False][False]
-    mission = found[MISSION, False][False]
+    mission, msis = found[MISSION, False][False], found[MISSION_MSIS, False][False]
     return lines + ['', 'The body alone, over its step under a constant torque: ' + '; '.join(
         f'{name} {inlined:.1f}x in the stages, {called:.1f}x called'
         for name, inlined, called in ratios) + f'. The whole mission model costs '
         f'{mission / dipole:.2f}x the step with the gravity gradient, the dipole field and '
-        f'the residual dipole ({mission * 1e6:.1f} against {dipole * 1e6:.1f} us, this run). '
+        f'the residual dipole ({mission * 1e6:.1f} against {dipole * 1e6:.1f} us, this run); '
+        f'with NRLMSIS 2.1 for the air {msis / dipole:.2f}x ({msis * 1e6:.1f} us). '
         'What the statements leave: the orbit and '
         'the field at each distinct stage time (5 in an order-6 step; they depend on time '
         'alone), and the turn of the position and the field into the attitude of each '
