@@ -203,22 +203,26 @@ def test_a_tle_orbit_and_the_earth_turned_by_its_epoch_over_topics(launch, probe
     assert 'SGP4 of the TLE of NORAD 25544' in proc.output()
 
 
-def test_an_orbit_under_j2_to_j6_over_topics(launch, probe):
+def test_an_orbit_under_j2_to_j6_and_drag_over_topics(launch, probe):
     """
-    orbit_zonal_degree 6: odom's position = a tight DOP853 of the zonal equations at its stamps.
+    orbit_zonal_degree 6 with drag: odom's position = a tight DOP853 of those equations.
 
     The reference integrates :func:`zonal_acceleration` (held to the J2 closed form and
-    to the potential's gradient in test_zonal_orbit) from the elements' Kepler state at
-    rtol 2.5e-14; 1e-10 of |r| over 400 s, where the orbit is 3e-5 of |r| off Kepler's.
+    to the potential's gradient in test_zonal_orbit) plus the drag -1/2 rho |v_r| v_r / B
+    written here (B = 50 kg/m^2, Vallado's table, the air turning with the Earth) from
+    the elements' Kepler state at rtol 2.5e-14; 1e-10 of |r| over 400 s, where the orbit
+    is 3e-5 of |r| off Kepler's and the drag has moved it about 2e-8 of |r|.
     """
+    from rigid_body_dynamics.physics.environment import EARTH_RATE, ExponentialAtmosphere
     from rigid_body_dynamics.physics.environment.zonal_orbit import (EGM2008_RADIUS,
                                                                      zonal_acceleration,
                                                                      zonal_coefficients)
     from scipy.integrate import solve_ivp
-    elements = [6778137.0, 0.001, 0.9, 0.3, 0.5, 0.2]
+    elements, ballistic = [6778137.0, 0.001, 0.9, 0.3, 0.5, 0.2], 50.0
     proc = launch(SIM, '-p', 'publish_clock:=true', '-p', f'orbit_elements:={elements}',
-                  '-p', 'orbit_zonal_degree:=6', '-p', 'integration_rate:=10.0',
-                  '-p', 'publish_rate:=1.0', '-p', 'real_time_factor:=200.0', name='zonal')
+                  '-p', 'orbit_zonal_degree:=6', '-p', f'orbit_ballistic_coefficient:={ballistic}',
+                  '-p', 'integration_rate:=10.0', '-p', 'publish_rate:=1.0',
+                  '-p', 'real_time_factor:=200.0', name='zonal')
     odom = probe.subscribe(Odometry, 'odom')
     # At 200 times real time the probe may match the publisher a few hundred seconds of
     # simulated time late (seen in CI beside a CPU hog): what is compared is what arrived.
@@ -230,18 +234,28 @@ def test_an_orbit_under_j2_to_j6_over_topics(launch, probe):
     j = zonal_coefficients(6)
     r0, v0 = KeplerOrbit(elements).state(0.0)
     mu = KeplerOrbit(elements).mu
+    air = ExponentialAtmosphere(EARTH_RATE)
 
-    def rate(t, y):
-        return (*y[3:], *zonal_acceleration(y[:3], mu, EGM2008_RADIUS, j))
-    reference = solve_ivp(rate, (0.0, stamps[-1]), np.array(r0 + v0), method='DOP853',
-                          rtol=2.5e-14, atol=1e-12, t_eval=stamps)
-    assert reference.success and len(stamps) >= 100, len(stamps)
-    error = np.linalg.norm(got - reference.y[:3].T, axis=1) / elements[0]
+    def rate(t, y, drag=True):
+        a = np.array(zonal_acceleration(y[:3], mu, EGM2008_RADIUS, j))
+        flow = y[3:] - np.cross([0.0, 0.0, EARTH_RATE], y[:3])
+        if drag:
+            a -= 0.5 * air.density(t, y[:3]) * np.linalg.norm(flow) * flow / ballistic
+        return (*y[3:], *a)
+
+    def reference(drag):
+        found = solve_ivp(rate, (0.0, stamps[-1]), np.array(r0 + v0), method='DOP853',
+                          rtol=2.5e-14, atol=1e-12, t_eval=stamps, args=(drag,))
+        assert found.success
+        return np.linalg.norm(got - found.y[:3].T, axis=1) / elements[0]
+    assert len(stamps) >= 100, len(stamps)
+    error, dragless = reference(True), reference(False)
     kepler = np.linalg.norm(got[-1] - KeplerOrbit(elements).position(stamps[-1])) / elements[0]
-    assert error.max() < 1e-10 and kepler > 1e-5, (error.max(), kepler)
+    assert error.max() < 1e-10 and dragless[-1] > 5e-9 and kepler > 1e-5, (
+        error.max(), dragless[-1], kepler)
     code, _ = proc.stop()
     assert code == 0, proc.output()
-    assert 'integrated under J2..J6' in proc.output()
+    assert 'integrated under J2..J6 (EGM2008, DOP853), drag of B = 50 kg/m^2' in proc.output()
 
 
 @pytest.mark.parametrize('args, reason', [
@@ -281,6 +295,14 @@ def test_an_orbit_under_j2_to_j6_over_topics(launch, probe):
       'facets:=[0.01, 0.0, 0.0, 1.0, 0.05, 0.0, 0.0, 0.3, 0.2, 2.2]', '-p',
       'atmosphere_model:=nrlmsis'), 'atmosphere_model nrlmsis needs epoch'),
     (('-p', 'solar_flux_f107:=0.0'), 'solar_flux_f107'),
+    (('-p', 'orbit_elements:=[7.0e6, 0.0, 0.0, 0.0, 0.0, 0.0]', '-p',
+      'orbit_ballistic_coefficient:=50.0'),
+     'orbit_ballistic_coefficient needs orbit_zonal_degree'),
+    (('-p', f'orbit_tle:={list(ISS)}', '-p', 'orbit_ballistic_coefficient:=50.0'),
+     "SGP4 flies the TLE's own drag"),
+    (('-p', 'orbit_elements:=[7.0e6, 0.0, 0.0, 0.0, 0.0, 0.0]', '-p', 'orbit_zonal_degree:=2',
+      '-p', 'orbit_ballistic_coefficient:=50.0', '-p', 'atmosphere_model:=nrlmsis'),
+     'atmosphere_model nrlmsis needs epoch'),
 ])
 def test_bad_environment_parameters_are_refused_at_start_naming_them(launch, args, reason):
     proc = launch(SIM, *args, name='bad_environment')

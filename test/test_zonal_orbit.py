@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 import pytest
+from rigid_body_dynamics.physics.environment import EARTH_RATE, ExponentialAtmosphere
 from rigid_body_dynamics.physics.environment.orbit import KeplerOrbit, MU_EARTH
 from rigid_body_dynamics.physics.environment.zonal_orbit import (EGM2008_J, EGM2008_RADIUS,
                                                                  zonal_acceleration,
@@ -43,7 +44,13 @@ def _positions(rng, count):
 
 
 def test_j2_acceleration_is_the_closed_form(rng):
-    """Degree 2 = Vallado's eq. 8-30 to 2 ulps of |a|, the poles included."""
+    """
+    Degree 2 = Vallado's eq. 8-30 to 6 ulps of |a|, the poles included.
+
+    The two formulas round differently: over 20000 random positions the median
+    difference is 0.7 ulp, the 99.9th percentile 3.4, the worst 4.1; this test's 200
+    came to 4.13 on one machine, where the bound was 4.
+    """
     j = zonal_coefficients(2)
     for r in _positions(rng, 200):
         x, y, z = r
@@ -53,7 +60,7 @@ def test_j2_acceleration_is_the_closed_form(rng):
         expected = np.array([-k * x * (1.0 - s * (w - 1.0)), -k * y * (1.0 - s * (w - 1.0)),
                              -k * z * (1.0 - s * (w - 3.0))])
         got = np.array(zonal_acceleration(r, MU_EARTH, EGM2008_RADIUS, j))
-        assert np.linalg.norm(got - expected) < 4 * np.finfo(float).eps * np.linalg.norm(expected)
+        assert np.linalg.norm(got - expected) < 6 * np.finfo(float).eps * np.linalg.norm(expected)
 
 
 def test_acceleration_to_j6_is_the_gradient_of_the_potential(rng):
@@ -175,3 +182,118 @@ def test_an_orbit_that_comes_below_the_planet_is_refused_when_reached():
     with pytest.raises(ValueError, match='comes below planet_radius'):
         for t in np.linspace(0.0, 5 * DAY, 200):
             orbit.state(float(t))
+
+
+# ------------------------------------------------------------------------- drag on the orbit
+
+def _dragged(elements, atmosphere, ballistic=50.0, degree=6, coefficients=None):
+    return ZonalOrbit(elements, degree, coefficients=coefficients,
+                      ballistic_coefficient=ballistic, atmosphere=atmosphere)
+
+
+def test_drag_takes_the_energy_its_work_says():
+    """
+    E(T) - E(0) = the integral of a_D . v over a day, by Gauss-Legendre on the interpolant.
+
+    J2..J6 and the air turning with the Earth; the orbit at 425 km on the equator stays in
+    one band of Vallado's table (a smooth integrand). The day's work is about 980 m^2/s^2;
+    the two agree to 2e-6 m^2/s^2, 7e-14 of the orbit's energy (the interpolated state's
+    round-off), held to 3e-13 of it.
+    """
+    orbit = _dragged([6378137.0 + 425e3, 0.0005, 0.0, 0.3, 0.5, 0.2],
+                     ExponentialAtmosphere(EARTH_RATE))
+
+    def energy(t):
+        r, v = orbit.state(t)
+        return 0.5 * np.dot(v, v) - zonal_potential(r, orbit.mu, EGM2008_RADIUS, orbit.j)
+
+    x, w = np.polynomial.legendre.leggauss(12)
+    edges = np.linspace(0.0, DAY, 1601)
+    work = 0.0
+    for a, b in zip(edges[:-1], edges[1:]):
+        for xk, wk in zip(x, w):
+            t = 0.5 * (a + b) + 0.5 * (b - a) * xk
+            r, v = orbit.state(t)
+            work += wk * 0.5 * (b - a) * np.dot(orbit.drag_acceleration(t, r, v), v)
+    assert work < -900.0
+    assert abs(energy(DAY) - energy(0.0) - work) < 3e-13 * abs(energy(0.0))
+
+
+def test_a_circular_orbit_decays_at_king_heles_rate():
+    """
+    da/dt = -rho(a) sqrt(mu a) / B on a circular orbit (central gravity, air at rest).
+
+    King-Hele, Theory of Satellite Orbits in an Atmosphere (1964): the mean semi-major
+    axis over ten days (about 3 km lost from 425 km at B = 50 kg/m^2) against that
+    equation integrated by scipy's solve_ivp with the table's band written here (the
+    orbit on the equator: its height over the ellipsoid is |r| - 6378137 m). Measured
+    within 3e-9 of the decay, held to 3e-8.
+    """
+    a0, rho0, h0, scale = 6378137.0 + 425e3, 3.725e-12, 400e3, 58.515e3
+    orbit = _dragged([a0, 0.0, 0.0, 0.0, 0.0, 0.0], ExponentialAtmosphere(0.0), degree=2,
+                     coefficients=(0.0, 0.0, 0.0))
+
+    def mean_a(t):
+        """Return the semi-major axis (m) averaged over the orbit from t (s)."""
+        values = []
+        for s in np.linspace(t, t + orbit.period, 64, endpoint=False):
+            r, v = orbit.state(float(s))
+            values.append(1.0 / (2.0 / np.linalg.norm(r) - np.dot(v, v) / MU_EARTH))
+        return float(np.mean(values))
+
+    def decay(t, a):
+        rho = rho0 * math.exp(-(a[0] - 6378137.0 - h0) / scale)
+        return [-rho * math.sqrt(MU_EARTH * a[0]) / 50.0]
+
+    start = mean_a(0.0)
+    theory = solve_ivp(decay, (0.0, 10 * DAY), [start], method='DOP853', rtol=1e-12,
+                       atol=1e-6).y[0, -1]
+    found = mean_a(10 * DAY)
+    assert start - found > 2e3
+    assert found - start == pytest.approx(theory - start, rel=3e-8)
+
+
+class _OneScaleHeight(ExponentialAtmosphere):
+    """One exponential from 400 km (Vallado's band there) at every height: a smooth density."""
+
+    def density(self, t, r):
+        return 3.725e-12 * math.exp(-(np.linalg.norm(r) - 6378137.0 - 400e3) / 58.515e3)
+
+
+@pytest.mark.parametrize('air, bound', [('smooth', 1e-11), ('exponential', 2e-9),
+                                        ('nrlmsis', 5e-9)])
+def test_orbit_with_drag_is_a_tight_dop853_of_its_equations(air, bound):
+    """
+    r, v after a day of J2..J6 and drag = one DOP853 call at rtol 2.5e-14 (relative to a, v).
+
+    A smooth density (one scale height): measured 1e-12, as without drag. Vallado's
+    table bends the density's slope at its bands, which neither integration steps to:
+    1.2e-9 (8 mm). NRLMSIS computes in single precision, its density wandering by a few
+    1e-6 from one call to the next: 3e-9 (2 cm). Both far below what the density's own
+    uncertainty (ten percent) moves the orbit.
+    """
+    if air == 'smooth':
+        atmosphere = _OneScaleHeight(EARTH_RATE)
+    elif air == 'nrlmsis':
+        pytest.importorskip('pymsis')
+        from rigid_body_dynamics.physics.environment import MsisAtmosphere
+        atmosphere = MsisAtmosphere(None, 1.7e9, rotation_rate=EARTH_RATE)
+    else:
+        atmosphere = ExponentialAtmosphere(EARTH_RATE)
+    orbit = _dragged(ISS_LIKE, atmosphere)
+    r0, v0 = KeplerOrbit(ISS_LIKE).state(0.0)
+    reference = solve_ivp(orbit.rate, (0.0, DAY), np.array(r0 + v0), method='DOP853',
+                          rtol=2.5e-14, atol=1e-12, t_eval=[DAY])
+    r, v = orbit.state(DAY)
+    assert np.linalg.norm(np.array(r) - reference.y[:3, -1]) < bound * ISS_LIKE[0]
+    assert np.linalg.norm(np.array(v) - reference.y[3:, -1]) < bound * 7.7e3
+
+
+@pytest.mark.parametrize('ballistic, atmosphere, match', [
+    (-1.0, None, 'orbit_ballistic_coefficient must be >= 0'),
+    (math.nan, None, 'orbit_ballistic_coefficient must be >= 0'),
+    (50.0, None, 'orbit_ballistic_coefficient needs an atmosphere')])
+def test_a_bad_ballistic_coefficient_is_refused_naming_the_parameter(ballistic, atmosphere,
+                                                                     match):
+    with pytest.raises(ValueError, match=match):
+        ZonalOrbit(ISS_LIKE, 2, ballistic_coefficient=ballistic, atmosphere=atmosphere)

@@ -41,6 +41,14 @@ ENVIRONMENT_PARAMS = {p.name: p for p in (
           '6378136.3 m; DOP853 at rtol 1e-13), the elements then osculating at t = 0, the '
           'world frame the same. Not with orbit_tle (SGP4 has its own J2 to J4).',
           low=0, high=6, read_only=True),
+    Param('orbit_ballistic_coefficient', 'double', 0.0, '0.0 kg/m^2 (no drag on the orbit)',
+          'With orbit_zonal_degree 2..6: the drag of the air on the orbit, '
+          '-1/2 rho |v_r| v_r / B, B = m / (C_D A) this ballistic coefficient (kg/m^2: the mass '
+          'over the drag coefficient times the area facing the flow, taken constant), rho '
+          'from atmosphere_model, v_r the velocity relative to the air turning with the '
+          'Earth. 0 = none. With nrlmsis every step of the orbit calls the model (a tenth of '
+          'a second per orbit, once). Not with orbit_tle (SGP4 has its own drag, the B* of '
+          'the TLE).', low=0.0, high=1e6, read_only=True),
     Param('orbit_mu', 'double', MU_EARTH, '3.986004418e14 m^3/s^2',
           "The planet's gravitational parameter mu (m^3/s^2).", low=1e-30, high=1e30,
           read_only=True),
@@ -146,6 +154,14 @@ def orbit_from(out):
     """
     elements, tle = out.get('orbit_elements'), out.get('orbit_tle')
     degree = out.get('orbit_zonal_degree') or 0
+    ballistic = out.get('orbit_ballistic_coefficient') or 0.0
+    if ballistic and tle is not None:
+        raise ConfigurationError('orbit_ballistic_coefficient is not for orbit_tle: SGP4 flies '
+                                 "the TLE's own drag (its B*)")
+    if ballistic and not degree:
+        raise ConfigurationError('orbit_ballistic_coefficient needs orbit_zonal_degree 2..6 '
+                                 '(the drag acts on the integrated orbit, not on the Kepler '
+                                 'one)')
     if elements is not None and tle is not None:
         raise ConfigurationError('orbit_elements and orbit_tle are both set: set one (the '
                                  'Kepler orbit or the TLE)')
@@ -158,7 +174,9 @@ def orbit_from(out):
         if tle is not None:
             return TleOrbit(*tle, epoch=out.get('epoch') or None)
         if degree:
-            return ZonalOrbit(elements, degree, out['orbit_mu'], out['planet_radius'])
+            air = atmosphere_from(out, None) if ballistic else None
+            return ZonalOrbit(elements, degree, out['orbit_mu'], out['planet_radius'],
+                              ballistic_coefficient=ballistic, atmosphere=air)
         if elements is not None:
             return KeplerOrbit(elements, out['orbit_mu'], out['planet_radius'])
     except ValueError as err:
@@ -259,7 +277,8 @@ def atmosphere_from(out, orbit):
     Return the atmosphere of validated values ``out`` on ``orbit`` (refusing with the reason).
 
     ``exponential``: Vallado's table; ``nrlmsis``: NRLMSIS 2.1 along the orbit from the
-    epoch's date, with the solar and geomagnetic activity, the Earth turned as for the field.
+    epoch's date, with the solar and geomagnetic activity, the Earth turned as for the field;
+    with ``orbit`` None, the model itself at any time and place (the orbit's own drag).
     """
     if out['atmosphere_model'] == 'exponential':
         return ExponentialAtmosphere(out['earth_rotation_rate'])

@@ -55,7 +55,9 @@ class MsisAtmosphere:
     geomagnetic index; ``rotation_angle`` theta0 (rad) and ``rotation_rate`` (rad/s)
     turn the Earth-fixed frame about the world z axis, and the air turns with it.
     :meth:`density` (t s, r m) is interpolated along the orbit (``r`` must be the
-    orbit's position at t); :meth:`exact` calls the model at any (t, r). Refuses
+    orbit's position at t); :meth:`exact` calls the model at any (t, r). With
+    ``orbit`` None there is no interpolant and :meth:`density` is :meth:`exact` (the
+    density the orbit's own drag integrates through, :mod:`.zonal_orbit`). Refuses
     (ValueError naming the parameter) activity out of range and a missing pymsis.
     """
 
@@ -78,6 +80,9 @@ class MsisAtmosphere:
         self.orbit, self.start = orbit, float(start)
         self.f107, self.f107a, self.ap = float(f107), float(f107a), float(ap)
         self.theta0, self.earth_rate = float(rotation_angle), float(rotation_rate)
+        if orbit is None:
+            self.density = self.exact
+            return
         # segments that meet at every 0 h UTC, where the model's day of the year steps
         per_day = max(1, round(DAY / (orbit.period / segments)))
         self.interpolant = ChebyshevSegments(self._sample, DAY / per_day, order, name='nrlmsis',
