@@ -55,7 +55,7 @@ def main():
                                            'simulate-cost', 'wheels', 'wheels-node',
                                            'environment', 'environment-node', 'estimation',
                                            'discovery', 'late-steps', 'bodies-wheels',
-                                           'fleet-check'],
+                                           'fleet-check', 'surface'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -121,6 +121,7 @@ SCALE = {
     'wheels-node': ('wheels_node', 'attitude_simulator with reaction wheels: CPU'),
     'environment': ('environment', 'A satellite in orbit beside Basilisk'),
     'environment-node': ('environment_node', 'attitude_simulator in orbit: CPU'),
+    'surface': ('surface', "The air's drag on a CubeSat's facets beside Basilisk"),
     'estimation': ('estimation', "The estimator's sensors and the example MEKF"),
     'discovery': ('discovery', 'DDS discovery time and the number of participants'),
     'bodies-wheels': ('bodies_wheels', 'Many bodies with reaction wheels in fleets'),

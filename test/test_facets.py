@@ -160,6 +160,37 @@ def test_the_solar_pressure_torque_is_zero_in_umbra_and_scaled_in_the_penumbra()
 
 #: The engine runs under one torque each: (name, tolerance (rad, and relative), the least
 #: change of omega the torque makes (rad/s)).
+def dop853_through_kinks(rate, y0, end, times, kinks):
+    """
+    Return the states (len(times), n) of scipy's DOP853 at rtol 2.5e-14, stopped at each kink.
+
+    ``kinks``: event functions g(t, y) whose zeros are where the right-hand side has a
+    kink (a facet turning into the light or the flow, the penumbra's edges). A step
+    across one is of low order whatever its tolerance (an adaptive step's error
+    estimate does not see it), so the integration ends there and starts again, first a
+    microsecond without the events so that the same zero is not found again (the kink
+    inside that step moves the state by the square of a microsecond).
+    """
+    from scipy.integrate import solve_ivp
+    for g in kinks:
+        g.terminal = True
+    t, y, out = 0.0, np.asarray(y0, float), []
+    while True:
+        piece = solve_ivp(rate, (t, end), y, method='DOP853', rtol=2.5e-14, atol=1e-18,
+                          t_eval=times[len(out):], events=kinks)
+        assert piece.success, piece.message
+        out += list(piece.y.T) if len(piece.t) else []
+        if piece.status != 1:
+            break
+        k = [len(e) > 0 for e in piece.t_events].index(True)
+        t, y = float(piece.t_events[k][0]), piece.y_events[k][0]
+        past = solve_ivp(rate, (t, t + 1e-6), y, method='DOP853', rtol=2.5e-14, atol=1e-18)
+        out += [past.y[:, -1]] * int(np.sum((times > t) & (times <= t + 1e-6)))
+        t, y = t + 1e-6, past.y[:, -1]
+    assert len(out) == len(times)
+    return np.array(out)
+
+
 ENGINE_CASES = [('solar pressure', 1.5e-12, 1e-7), ('drag', 2e-12, 1e-4),
                 ('drag nrlmsis', 2e-12, 1e-4)]
 
@@ -174,15 +205,18 @@ def test_a_body_under_the_surface_torques_through_the_engine_against_an_independ
     circular orbit half-way through the conical shadow's penumbra at 15 s, 30 s in all
     (sunlight, penumbra, umbra) at 1 ms steps. The reference integrates Euler's
     equations with the full body-frame tensor (no principal axes) by DOP853 at rtol
-    2.5e-14, with the torque from the facets' own force: the Sun's light at the Sun's
-    direction from the body, the pressure written here (1361 W/m^2 / c (au / d)^2 times
+    2.5e-14 from kink to kink (:func:`dop853_through_kinks`: a facet pair turning to the
+    Sun or the flow, the penumbra's two edges; stepping across them, the reference
+    itself was off by up to 2e-12, by where its steps fell), with the torque from the
+    facets' own force: the Sun's light at the Sun's direction from the body, the
+    pressure written here (1361 W/m^2 / c (au / d)^2 times
     the conical fraction; about 2e-6 N m); or the air at v - omega_E x r, the density
     written here from Vallado's 400 km band (3.725e-12 kg/m^3, H = 58.515 km; about
     1e-4 N m), or with atmosphere nrlmsis NRLMSIS 2.1's density along the orbit (its
     interpolant, the density the stages are given: test_msis_atmosphere holds it to the
     model). Attitude and omega every 0.1 s within ``tol`` (rad, and relative):
-    delivered 4.8e-13 and 6.2e-13 under the light, 6.1e-13 and 9.0e-13 under drag
-    (7.0e-13 and 9.3e-13 with NRLMSIS). The
+    delivered 8.8e-13 and 8.4e-13 under the light, 5.8e-13 and 8.7e-13 under drag
+    (5.2e-13 and 6.7e-13 with NRLMSIS). The engine's
     error is made where a facet turns into the light or the flow: a kink in the torque
     which the fixed step does not stop at, of order dt^2 times the jump in the torque's
     rate. (At 400 km, the base of one of Vallado's bands, the altitude's round-off
@@ -195,7 +229,6 @@ def test_a_body_under_the_surface_torques_through_the_engine_against_an_independ
                                                          R_EARTH, Sun)
     from rigid_body_dynamics.physics.environment.shadow import conical_shadow_fraction
     from rigid_body_dynamics.physics.inertia import Inertia
-    from scipy.integrate import solve_ivp
     from scipy.optimize import brentq
     au, sun = 149597870700.0, np.array([149597870700.0, 0.0, 0.0])
     earth_rate = 7.2921150e-5
@@ -257,15 +290,34 @@ def test_a_body_under_the_surface_torques_through_the_engine_against_an_independ
         tau = torque(t, Rotation.from_quat(q))
         return np.r_[dq, inverse @ (tau - np.cross(w, tensor @ w))]
 
+    def facing(axis):
+        """Return the event of a box's facet pair turning to the Sun or the flow."""
+        def event(t, y):
+            r, v = (np.array(x) for x in orbit.state(t))
+            along = v - np.cross([0.0, 0.0, earth_rate], r) if case.startswith('drag') \
+                else sun - r
+            return Rotation.from_quat(y[:4] / np.linalg.norm(y[:4])).inv().apply(along)[axis]
+        return event
+
+    def contact(edge):
+        """Return the event of the body at the penumbra's outer (0) or inner (1) edge."""
+        def event(t, y):
+            r = np.array(orbit.position(t))
+            c = math.acos(np.dot(-r, sun - r) / (np.linalg.norm(r) * np.linalg.norm(sun - r)))
+            a = math.asin(6.957e8 / np.linalg.norm(sun - r))
+            b = math.asin(R_EARTH / np.linalg.norm(r))
+            return c - (a + b if edge == 0 else b - a)
+        return event
+
     times = np.arange(1, round(seconds / 0.1) + 1) * 0.1
-    ref = solve_ivp(rate, (0.0, seconds), np.r_[q0, w0], method='DOP853', rtol=2.5e-14,
-                    atol=1e-18, t_eval=times)
-    assert ref.success
+    kinks = [facing(k) for k in range(3)] + ([contact(0), contact(1)] if case == 'solar pressure'
+                                             else [])
+    ref = dop853_through_kinks(rate, np.r_[q0, w0], seconds, times, kinks)
     qs, ws = run(True)
     assert len(qs) == len(times)
     worst_q = max(quaternions.angle_between(q, r / np.linalg.norm(r))
-                  for q, r in zip(qs, ref.y[:4].T))
-    worst_w = max(np.linalg.norm(w - r) / np.linalg.norm(r) for w, r in zip(ws, ref.y[4:].T))
+                  for q, r in zip(qs, ref[:, :4]))
+    worst_w = max(np.linalg.norm(w - r) / np.linalg.norm(r) for w, r in zip(ws, ref[:, 4:]))
     assert worst_q < tol and worst_w < tol, (worst_q, worst_w)
     _, free = run(False)
     assert np.linalg.norm(free[-1] - ws[-1]) > moved
