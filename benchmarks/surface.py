@@ -11,7 +11,8 @@ one exponential, rho = 2.418e-11 exp(-(|r| - R - 300 km) / 53.628 km) kg/m^3 (Va
 300 km band, on a sphere: Basilisk's ``exponentialAtmosphere``), at rest (Basilisk's drag
 takes the inertial velocity unless a wind message is linked); drag alone, 1000 s.
 Reference: scipy's DOP853 at rtol 2.5e-14 of Euler's equations with the drag torque of
-the facets at the Kepler orbit's state, written here apart from the engine. Errors are
+the facets at the Kepler orbit's state, written here apart from the engine, stopped and
+started again wherever a facet pair turns into the flow (a kink in the torque). Errors are
 the largest over the 1000 samples (1 s apart): attitude (rad), omega relative to the
 largest |omega|. The torque row compares the two drag models at the 1000 states
 Basilisk reached: its ``torqueExternalPntB_B`` against ``Facets.drag_force`` at the same
@@ -237,7 +238,18 @@ def measure(progress=print):
     return lines + ['', NOTE]
 
 
-NOTE = ''
+NOTE = ('The two drag models are the same flat-plate formula: their torques agree to '
+        'round-off. The difference is where they are evaluated. Basilisk reads the density '
+        'once per task step and holds it; on this orbit (e = 0.005, a radial speed up to 39 '
+        'm/s through a 53.6 km scale height) the density moves by 7e-4 of itself per second, '
+        'so its error is first order in the step, 2.7e-6 rad at 1 ms and 2.7e-5 at 10 ms, '
+        'whatever the integrator (RKF78 as RK4). Ours evaluates the orbit, the density and '
+        'the torque at every stage; what it leaves is where a facet pair turns into the '
+        'flow, a kink in the torque that the fixed step does not stop at (of order dt^2 '
+        'times the jump in the rate of the torque): 7.6e-11 rad at 1 ms, 1.8e-9 at 10 ms. '
+        'Ours at 10 ms is about 1500 times closer than Basilisk RK4 at 1 ms, at a third of '
+        'its cost; step for step ours costs about three times Basilisk RK4 (Python stages '
+        'against C++).')
 
 
 if __name__ == '__main__':
