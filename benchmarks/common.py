@@ -54,6 +54,19 @@ def errors(moments, omega0, q0, t, q, omega):
     return float(energy.max()), float(norm.max()), float(direction.max()), float(attitude.max())
 
 
+def attitude_errors(q_ref, w_ref, qs, ws):
+    """
+    Return (largest attitude error (rad), largest omega error relative to max |omega|).
+
+    ``q_ref``, ``qs`` (N, 4) quaternions and ``w_ref``, ``ws`` (N, 3) rates (rad/s) at the
+    same N times.
+    """
+    attitude = float(np.max(quaternions.angle_between(np.array(qs), q_ref)))
+    omega = float(np.max(np.linalg.norm(np.array(ws) - w_ref, axis=1))
+                  / np.max(np.linalg.norm(w_ref, axis=1)))
+    return attitude, omega
+
+
 def fmt(x):
     """Format a table cell in short scientific notation."""
     if x is None:

@@ -23,9 +23,9 @@ once per task step and holds it over the step; the gravity gradient at every sta
 import math
 import time
 
-from common import fmt
+from common import attitude_errors, fmt
 import numpy as np
-from peers import basilisk_attitude, basilisk_body
+from peers import basilisk_attitude, basilisk_in_orbit
 from rigid_body_dynamics.engine import BodySimulation, DipoleCommands, Disturbances
 from rigid_body_dynamics.physics import Inertia, quaternions
 from rigid_body_dynamics.physics.dynamics.reference import space_zoh_reference
@@ -36,6 +36,9 @@ ELEMENTS = (7.0e6, 0.01, 1.7, 0.8, 0.3, 0.2)
 MOMENTS = (10.5, 8.0, 6.75)
 OMEGA0 = (0.02, -0.05, 0.03)
 Q0 = tuple(float(c) for c in quaternions.normalize(np.array([0.1, 0.2, -0.3, 0.9])))
+#: The reference's field as numbers, from their source: IGRF-13's 2020.0 dipole (g10, g11,
+#: h11 nT), its reference radius (m), no rotation (rad/s) and angle 0 (rad).
+REFERENCE_FIELD = (-29404.8, -1450.9, 4652.5, 6371.2e3, 0.0, 0.0)
 HOLD = 1.0
 DURATION = 1000.0
 HOLDS = int(round(DURATION / HOLD))
@@ -72,20 +75,10 @@ def _run_ours(dt, integrator):
 def _run_basilisk(dt, integrator):
     from Basilisk.architecture import messaging
     from Basilisk.simulation import (GravityGradientEffector, magneticFieldCenteredDipole,
-                                     MtbEffector, spacecraft)
-    from Basilisk.utilities import macros, simIncludeGravBody
-    from scipy.spatial.transform import Rotation
-    sim, craft = basilisk_body(MOMENTS, OMEGA0, dt, integrator)
-    gravity = simIncludeGravBody.gravBodyFactory()
-    earth = gravity.createEarth()
-    earth.isCentralBody = True
-    earth.mu = MU
+                                     MtbEffector)
+    from Basilisk.utilities import macros
     r0, v0 = KeplerOrbit(ELEMENTS, mu=MU).state(0.0)
-    craft.hub.r_CN_NInit = [[c] for c in r0]
-    craft.hub.v_CN_NInit = [[c] for c in v0]
-    # Basilisk's attitude: MRPs of B relative to N (N -> B); ours q is body -> world
-    craft.hub.sigma_BNInit = [[c] for c in Rotation.from_quat(Q0).as_mrp()]
-    craft.gravField.gravBodies = spacecraft.GravBodyVector(list(gravity.gravBodies.values()))
+    sim, craft, earth = basilisk_in_orbit(MOMENTS, OMEGA0, Q0, r0, v0, MU, dt, integrator)
     gg = GravityGradientEffector.GravityGradientEffector()
     gg.addPlanetName(earth.planetName)
     craft.addDynamicEffector(gg)
@@ -129,20 +122,12 @@ def _run_basilisk(dt, integrator):
     return (time.perf_counter() - start) / DURATION, qs, ws
 
 
-def _errors(ref, qs, ws):
-    q_ref, w_ref, _r = ref
-    attitude = float(np.max(quaternions.angle_between(np.array(qs), q_ref)))
-    omega = float(np.max(np.linalg.norm(np.array(ws) - w_ref, axis=1))
-                  / np.max(np.linalg.norm(w_ref, axis=1)))
-    return attitude, omega
-
-
 def measure(progress=print):
     """Return RESULTS.md lines: E1, ours and Basilisk's against the reference."""
     progress('environment E1: reference (about a minute) ...')
     r0, v0 = KeplerOrbit(ELEMENTS, mu=MU).state(0.0)
     ref = space_zoh_reference(MOMENTS, MU, r0, v0, Q0, OMEGA0, HOLD, HOLDS,
-                              lambda k, _q, _w: dipole(k), field=_field())
+                              lambda k, _q, _w: dipole(k), field=REFERENCE_FIELD)
     turned = float(np.max(np.linalg.norm(ref[1] - ref[1][0], axis=1)))
     runs = [(f'ours `{m}`', dt, lambda m=m, dt=dt: _run_ours(dt, m))
             for m in ('exact', 'rk4') for dt in (1e-3, 1e-2)]
@@ -157,7 +142,7 @@ def measure(progress=print):
         except ImportError as err:
             rows.append(f'| {label} | {dt * 1e3:g} | not installed ({err.name}) | | |')
             continue
-        attitude, omega = _errors(ref, qs, ws)
+        attitude, omega = attitude_errors(ref[0], ref[1], qs, ws)
         rows.append(f'| {label} | {dt * 1e3:g} | {fmt(attitude)} | {fmt(omega)} | '
                     f'{cost * 1e3:.1f} |')
     return ([f'The torques moved omega by {turned:.2e} rad/s over the run.', '',

@@ -70,6 +70,29 @@ def basilisk_body(moments, omega0, dt, integrator):
     return sim, craft
 
 
+def basilisk_in_orbit(moments, omega0, q0, r0, v0, mu, dt, integrator):
+    """
+    (sim, craft, earth): a Basilisk hub on an orbit about a point-mass Earth of ``mu``.
+
+    ``q0`` (x-y-z-w, body -> world) and ``omega0`` (rad/s, body) the attitude; ``r0``
+    (m) and ``v0`` (m/s) the orbit's state at t = 0, world frame; ``dt`` (s) the task
+    step and ``integrator`` the name of one of Basilisk's svIntegrators.
+    """
+    from Basilisk.simulation import spacecraft
+    from Basilisk.utilities import simIncludeGravBody
+    sim, craft = basilisk_body(moments, omega0, dt, integrator)
+    gravity = simIncludeGravBody.gravBodyFactory()
+    earth = gravity.createEarth()
+    earth.isCentralBody = True
+    earth.mu = mu
+    craft.hub.r_CN_NInit = [[c] for c in r0]
+    craft.hub.v_CN_NInit = [[c] for c in v0]
+    # Basilisk's attitude: MRPs of B relative to N (N -> B); ours q is body -> world
+    craft.hub.sigma_BNInit = [[c] for c in Rotation.from_quat(q0).as_mrp()]
+    craft.gravField.gravBodies = spacecraft.GravBodyVector(list(gravity.gravBodies.values()))
+    return sim, craft, earth
+
+
 def basilisk_attitude(craft):
     """Return (q x-y-z-w body -> world, omega rad/s body) from a Basilisk craft's state."""
     from Basilisk.utilities import RigidBodyKinematics

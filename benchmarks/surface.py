@@ -28,9 +28,9 @@ surface`` (Basilisk: ``pip install bsk==2.12.1``).
 import math
 import time
 
-from common import fmt
+from common import attitude_errors, fmt
 import numpy as np
-from peers import basilisk_attitude, basilisk_body
+from peers import basilisk_attitude, basilisk_in_orbit
 from rigid_body_dynamics.engine import BodySimulation, Disturbances
 from rigid_body_dynamics.physics import Inertia, quaternions
 from rigid_body_dynamics.physics.environment import Facets, KeplerOrbit
@@ -134,21 +134,11 @@ def _run_ours(dt):
 
 
 def _run_basilisk(dt, integrator):
-    from Basilisk.simulation import exponentialAtmosphere, facetDragDynamicEffector, spacecraft
-    from Basilisk.utilities import macros, simIncludeGravBody
-    from scipy.spatial.transform import Rotation
-    sim, craft = basilisk_body(MOMENTS, OMEGA0, dt, integrator)
-    craft.hub.mHub = 1e9
-    gravity = simIncludeGravBody.gravBodyFactory()
-    earth = gravity.createEarth()
-    earth.isCentralBody = True
-    earth.mu = MU
+    from Basilisk.simulation import exponentialAtmosphere, facetDragDynamicEffector
+    from Basilisk.utilities import macros
     r0, v0 = KeplerOrbit(ELEMENTS, mu=MU).state(0.0)
-    craft.hub.r_CN_NInit = [[c] for c in r0]
-    craft.hub.v_CN_NInit = [[c] for c in v0]
-    # Basilisk's attitude: MRPs of B relative to N (N -> B); ours q is body -> world
-    craft.hub.sigma_BNInit = [[c] for c in Rotation.from_quat(Q0).as_mrp()]
-    craft.gravField.gravBodies = spacecraft.GravBodyVector(list(gravity.gravBodies.values()))
+    sim, craft, _ = basilisk_in_orbit(MOMENTS, OMEGA0, Q0, r0, v0, MU, dt, integrator)
+    craft.hub.mHub = 1e9
     air = exponentialAtmosphere.ExponentialAtmosphere()
     air.baseDensity = BASE_DENSITY * math.exp(BASE_HEIGHT / SCALE_HEIGHT)
     air.scaleHeight = SCALE_HEIGHT
@@ -195,14 +185,6 @@ def _torque_gap(craft, air, drag, facets):
     return float(np.linalg.norm(theirs - ours) / np.linalg.norm(ours))
 
 
-def _errors(ref, qs, ws):
-    q_ref, w_ref = ref
-    attitude = float(np.max(quaternions.angle_between(np.array(qs), q_ref)))
-    omega = float(np.max(np.linalg.norm(np.array(ws) - w_ref, axis=1))
-                  / np.max(np.linalg.norm(w_ref, axis=1)))
-    return attitude, omega
-
-
 def measure(progress=print):
     """Return RESULTS.md lines: E2, ours and Basilisk's against the reference."""
     progress('surface E2: reference ...')
@@ -223,7 +205,7 @@ def measure(progress=print):
             continue
         if gap:
             gaps[f'{label} at {dt * 1e3:g} ms'] = gap
-        attitude, omega = _errors(ref, qs, ws)
+        attitude, omega = attitude_errors(ref[0], ref[1], qs, ws)
         rows.append(f'| {label} | {dt * 1e3:g} | {fmt(attitude)} | {fmt(omega)} | '
                     f'{cost * 1e3:.1f} |')
     lines = [f'The drag moved omega by {moved:.2e} rad/s over the run (against the same '
