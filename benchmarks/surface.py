@@ -33,6 +33,7 @@ import numpy as np
 from peers import basilisk_attitude, basilisk_in_orbit
 from rigid_body_dynamics.engine import BodySimulation, Disturbances
 from rigid_body_dynamics.physics import Inertia, quaternions
+from rigid_body_dynamics.physics.dynamics.reference import dop853_through_kinks
 from rigid_body_dynamics.physics.environment import Facets, KeplerOrbit
 from rigid_body_dynamics.physics.environment.facets import box
 
@@ -68,7 +69,6 @@ class SphericalExponential:
 
 def _reference(drag=True):
     """Return (q (N, 4), omega (N, 3)) at the samples, DOP853 of the equations written here."""
-    from scipy.integrate import solve_ivp
     from scipy.spatial.transform import Rotation
     orbit, air, facets = KeplerOrbit(ELEMENTS, mu=MU), SphericalExponential(), Facets(SURFACE)
     moments = np.array(MOMENTS)
@@ -88,32 +88,14 @@ def _reference(drag=True):
         def event(t, y):
             turn = Rotation.from_quat(y[:4] / np.linalg.norm(y[:4]))
             return turn.inv().apply(orbit.state(t)[1])[axis]
-        event.terminal = True
         return event
 
     # DOP853 from crossing to crossing: where a facet pair turns into the flow the torque
     # has a kink, which is then the end of a piece, never inside a step
-    times = np.arange(SAMPLES + 1) * SAMPLE
-    t, y, qs, ws = 0.0, np.r_[Q0, OMEGA0], [], []
-    events = [crossing(k) for k in range(3)] if drag else None
-    while True:
-        out = solve_ivp(rate, (t, DURATION), y, method='DOP853', rtol=2.5e-14, atol=1e-18,
-                        t_eval=times[len(qs):], events=events)
-        assert out.success, out.message
-        if len(out.t):
-            qs += list(out.y[:4].T)
-            ws += list(out.y[4:].T)
-        if out.status != 1:
-            break
-        k = [len(e) > 0 for e in out.t_events].index(True)
-        t, y = float(out.t_events[k][0]), out.y_events[k][0]
-        # a microsecond past the crossing without events, so that it is not found again
-        # (the kink inside that step moves the state by the square of a microsecond)
-        past = solve_ivp(rate, (t, t + 1e-6), y, method='DOP853', rtol=2.5e-14, atol=1e-18)
-        t, y = t + 1e-6, past.y[:, -1]
-    assert len(qs) == len(times)
-    q = np.array(qs) / np.linalg.norm(qs, axis=1)[:, None]
-    return q, np.array(ws)
+    out = dop853_through_kinks(rate, np.r_[Q0, OMEGA0], DURATION,
+                               np.arange(SAMPLES + 1) * SAMPLE,
+                               [crossing(k) for k in range(3)] if drag else [])
+    return out[:, :4] / np.linalg.norm(out[:, :4], axis=1)[:, None], out[:, 4:]
 
 
 def _run_ours(dt):

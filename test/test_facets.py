@@ -160,37 +160,6 @@ def test_the_solar_pressure_torque_is_zero_in_umbra_and_scaled_in_the_penumbra()
 
 #: The engine runs under one torque each: (name, tolerance (rad, and relative), the least
 #: change of omega the torque makes (rad/s)).
-def dop853_through_kinks(rate, y0, end, times, kinks):
-    """
-    Return the states (len(times), n) of scipy's DOP853 at rtol 2.5e-14, stopped at each kink.
-
-    ``kinks``: event functions g(t, y) whose zeros are where the right-hand side has a
-    kink (a facet turning into the light or the flow, the penumbra's edges). A step
-    across one is of low order whatever its tolerance (an adaptive step's error
-    estimate does not see it), so the integration ends there and starts again, first a
-    microsecond without the events so that the same zero is not found again (the kink
-    inside that step moves the state by the square of a microsecond).
-    """
-    from scipy.integrate import solve_ivp
-    for g in kinks:
-        g.terminal = True
-    t, y, out = 0.0, np.asarray(y0, float), []
-    while True:
-        piece = solve_ivp(rate, (t, end), y, method='DOP853', rtol=2.5e-14, atol=1e-18,
-                          t_eval=times[len(out):], events=kinks)
-        assert piece.success, piece.message
-        out += list(piece.y.T) if len(piece.t) else []
-        if piece.status != 1:
-            break
-        k = [len(e) > 0 for e in piece.t_events].index(True)
-        t, y = float(piece.t_events[k][0]), piece.y_events[k][0]
-        past = solve_ivp(rate, (t, t + 1e-6), y, method='DOP853', rtol=2.5e-14, atol=1e-18)
-        out += [past.y[:, -1]] * int(np.sum((times > t) & (times <= t + 1e-6)))
-        t, y = t + 1e-6, past.y[:, -1]
-    assert len(out) == len(times)
-    return np.array(out)
-
-
 ENGINE_CASES = [('solar pressure', 1.5e-12, 1e-7), ('drag', 2e-12, 1e-4),
                 ('drag nrlmsis', 2e-12, 1e-4)]
 
@@ -205,7 +174,7 @@ def test_a_body_under_the_surface_torques_through_the_engine_against_an_independ
     circular orbit half-way through the conical shadow's penumbra at 15 s, 30 s in all
     (sunlight, penumbra, umbra) at 1 ms steps. The reference integrates Euler's
     equations with the full body-frame tensor (no principal axes) by DOP853 at rtol
-    2.5e-14 from kink to kink (:func:`dop853_through_kinks`: a facet pair turning to the
+    2.5e-14 from kink to kink (``reference.dop853_through_kinks``: a facet pair turning to the
     Sun or the flow, the penumbra's two edges; stepping across them, the reference
     itself was off by up to 2e-12, by where its steps fell), with the torque from the
     facets' own force: the Sun's light at the Sun's direction from the body, the
@@ -229,6 +198,7 @@ def test_a_body_under_the_surface_torques_through_the_engine_against_an_independ
                                                          R_EARTH, Sun)
     from rigid_body_dynamics.physics.environment.shadow import conical_shadow_fraction
     from rigid_body_dynamics.physics.inertia import Inertia
+    from rigid_body_dynamics.physics.dynamics.reference import dop853_through_kinks
     from scipy.optimize import brentq
     au, sun = 149597870700.0, np.array([149597870700.0, 0.0, 0.0])
     earth_rate = 7.2921150e-5

@@ -187,3 +187,36 @@ def space_zoh_reference(moments, mu, r0, v0, q0, omega0, hold, holds, command, f
         ws.append(y[:3].copy())
         rs.append(y[7:10].copy())
     return np.array(qs), np.array(ws), np.array(rs)
+
+
+def dop853_through_kinks(rate, y0, end, times, kinks, rtol=2.5e-14, atol=1e-18):
+    """
+    Return the states (len(times), n) of scipy's DOP853 from 0 to ``end`` s, stopped at kinks.
+
+    ``rate(t, y)`` the right-hand side; ``times`` (s, sorted, within [0, end]) where the
+    states are wanted; ``kinks`` event functions g(t, y) whose zeros are where the
+    right-hand side has a kink (a facet turning into the light or the flow, the edges of
+    a penumbra). A step across one is of low order whatever its tolerance (an adaptive
+    step's error estimate does not see it), so the integration ends there and starts
+    again: first a microsecond without the events, so that the same zero is not found
+    again (the kink inside that step moves the state by the square of a microsecond).
+    RuntimeError when an integration fails.
+    """
+    for g in kinks:
+        g.terminal = True
+    times = np.asarray(times, float)
+    t, y, out = 0.0, np.asarray(y0, float), []
+    while True:
+        piece = solve_ivp(rate, (t, end), y, method='DOP853', rtol=rtol, atol=atol,
+                          t_eval=times[len(out):], events=kinks or None)
+        if not piece.success:
+            raise RuntimeError(f'the reference failed at t = {t:g} s: {piece.message}')
+        out += list(piece.y.T) if len(piece.t) else []
+        if piece.status != 1:
+            break
+        k = [len(e) > 0 for e in piece.t_events].index(True)
+        t, y = float(piece.t_events[k][0]), piece.y_events[k][0]
+        past = solve_ivp(rate, (t, t + 1e-6), y, method='DOP853', rtol=rtol, atol=atol)
+        out += [past.y[:, -1]] * int(np.sum((times > t) & (times <= t + 1e-6)))
+        t, y = t + 1e-6, past.y[:, -1]
+    return np.array(out)
