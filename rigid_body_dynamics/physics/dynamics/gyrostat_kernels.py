@@ -192,6 +192,7 @@ def kernel_source(tableau, n, mode, friction, name='step', code=None, world=True
         lines.append('    gwx, gwy, gwz = tau_world')
     if mode == 'environment':
         lines += code.prologue()
+    at = len(lines)
     for k in wheels:
         absolute = f'so{k} + gx{k} * wx0 + gy{k} * wy0 + gz{k} * wz0'
         if friction:        # p_k = J_k (Omega_k + g_k . omega), a stage variable
@@ -210,6 +211,8 @@ def kernel_source(tableau, n, mode, friction, name='step', code=None, world=True
                 lines.append(f'    {var}{i} = {var}0 + {terms}' if terms else
                              f'    {var}{i} = {var}0')
         lines += _stage_lines(i, nodes[i], n, mode, friction, code, seen, world)
+    if mode == 'environment':
+        lines[at:at] = code.nodes_lines(tuple(seen))
     used = [(j, b) for j, b in enumerate(weights) if b != 0]
     # (each new value is its start plus the step's increment, so that the speeds are
     # rounded once per step as in the relative variables, not through p and back)

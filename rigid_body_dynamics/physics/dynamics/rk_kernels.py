@@ -79,16 +79,15 @@ def environment_lines(code, node, nodes, q, w):
     """
     Statements of the environment ``code`` (a StageCode) at a stage of ``node``: fx, fy, fz.
 
-    ``nodes`` maps the nodes seen so far in the step to their index (updated here):
-    a node's world quantities are computed once. ``q``, ``w``: the stage's attitude and
-    angular velocity names.
+    ``nodes`` maps the nodes seen so far in the step to their index j (updated here):
+    the kernel unpacks every node's world quantities once, at its start
+    (``StageCode.nodes_lines``). ``q``, ``w``: the stage's attitude and angular
+    velocity names.
     """
-    lines = []
     j = nodes.get(node)
     if j is None:
         j = nodes[node] = len(nodes)
-        lines += code.node_lines(j, f't + {literal(node)} * h')
-    return lines + code.stage_lines(j, q, w)
+    return code.stage_lines(j, q, w)
 
 
 def _derivative_lines(i, mode, node, code=None, nodes=None, world=True):
@@ -166,6 +165,7 @@ def kernel_source(tableau, mode, name='step', code=None, world=True):
                   '    hj1, hj2, hj3 = h * j1, h * j2, h * j3']
     if mode == 'environment':
         lines += code.prologue()
+    at = len(lines)
     for i, row in enumerate(rows):
         if i > 0:
             for var in _OMEGA + _QUAT:
@@ -174,6 +174,8 @@ def kernel_source(tableau, mode, name='step', code=None, world=True):
                 lines.append(f'    {var}{i} = {var}0 + {terms}' if terms else
                              f'    {var}{i} = {var}0')
         lines += _derivative_lines(i, mode, nodes[i], code, seen, world)
+    if mode == 'environment':
+        lines[at:at] = code.nodes_lines(tuple(seen))
     used = [(j, b) for j, b in enumerate(weights) if b != 0]
     for var in _OMEGA + _QUAT:
         terms = ' + '.join(f'{literal(b)} * d{var}{j}' for j, b in used)

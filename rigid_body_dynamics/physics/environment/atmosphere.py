@@ -19,6 +19,8 @@ at v - omega_E x r (world frame, z the rotation axis).
 from bisect import bisect_right
 import math
 
+import numpy as np
+
 #: Vallado's table 8-4: (base altitude h0 (km), density there rho0 (kg/m^3), scale height H
 #: (km)) per band, from the band's base to the next one's.
 EXPONENTIAL_TABLE = (
@@ -71,6 +73,27 @@ def geodetic_latitude_height(r, a=WGS84_A, f=WGS84_F):
     return lat, p * c + z * s - a * math.sqrt(1.0 - e2 * s * s)
 
 
+def geodetic_heights(r, a=WGS84_A, f=WGS84_F):
+    """
+    Return :func:`geodetic_altitude` (m, an (N,) array) of positions ``r`` (m, (N, 3)).
+
+    Bowring's same round, with the sines and cosines of his two angles taken from
+    their tangents' sides (square roots, no trigonometry).
+    """
+    x, y, z = r[:, 0], r[:, 1], r[:, 2]
+    p = np.hypot(x, y)
+    e2 = f * (2.0 - f)
+    b = a * (1.0 - f)
+    ep2 = e2 / (1.0 - e2)
+    u, w = a * z, b * p                         # tan(beta) = u / w
+    n = np.hypot(u, w)
+    sb, cb = u / n, w / n
+    u, w = z + ep2 * b * sb * sb * sb, p - e2 * a * cb * cb * cb     # tan(latitude)
+    n = np.hypot(u, w)
+    s, c = u / n, w / n
+    return p * c + z * s - a * np.sqrt(1.0 - e2 * s * s)
+
+
 def air_flow(earth_rate, r, v):
     """
     Return the velocity (m/s, world frame) relative to the air turning with the Earth.
@@ -79,6 +102,12 @@ def air_flow(earth_rate, r, v):
     (m) and ``v`` (m/s) in the world frame.
     """
     return (v[0] + earth_rate * r[1], v[1] - earth_rate * r[0], v[2])
+
+
+def air_flows(earth_rate, r, v):
+    """Return :func:`air_flow` at many places: ``r`` (m) and ``v`` (m/s), (N, 3) arrays."""
+    return np.column_stack((v[:, 0] + earth_rate * r[:, 1], v[:, 1] - earth_rate * r[:, 0],
+                            v[:, 2]))
 
 
 class ExponentialAtmosphere:
@@ -96,6 +125,7 @@ class ExponentialAtmosphere:
         if not math.isfinite(self.earth_rate):
             raise ValueError(f'the Earth rotation rate must be finite, got {earth_rate!r}')
         self._bases = [1e3 * h0 for h0, _, _ in EXPONENTIAL_TABLE]
+        self._table = np.array(EXPONENTIAL_TABLE).T          # (h0, rho0, H) by band
 
     def density(self, t, r):
         """
@@ -107,6 +137,13 @@ class ExponentialAtmosphere:
         h0, rho0, scale = EXPONENTIAL_TABLE[max(0, bisect_right(self._bases, h) - 1)]
         return rho0 * math.exp(-(h - 1e3 * h0) / (1e3 * scale))
 
+    def densities(self, times, r):
+        """Return :meth:`density` (kg/m^3, an (N,) array) at positions ``r`` (m, (N, 3))."""
+        h = geodetic_heights(r)
+        band = np.maximum(0, np.searchsorted(self._bases, h, side='right') - 1)
+        h0, rho0, scale = self._table[:, band]
+        return rho0 * np.exp(-(h - 1e3 * h0) / (1e3 * scale))
+
     def flow(self, r, v):
         """
         Return the body's velocity relative to the air (m/s, world frame): v - omega_E x r.
@@ -114,6 +151,10 @@ class ExponentialAtmosphere:
         ``r`` (m) and ``v`` (m/s), world frame.
         """
         return air_flow(self.earth_rate, r, v)
+
+    def flows(self, r, v):
+        """Return :meth:`flow` at many places: ``r`` (m) and ``v`` (m/s), (N, 3) arrays."""
+        return air_flows(self.earth_rate, r, v)
 
     def __str__(self):
         return 'exponential atmosphere (Vallado table 8-4)'

@@ -9,7 +9,9 @@ of degree ``order`` in
 x = (t - middle) / half-width, interpolating the function at the Chebyshev points
 of the first kind (Trefethen, Approximation Theory and Approximation Practice,
 chapter 4). A segment is built the first time it is asked for and kept (the last
-``keep`` of them); an evaluation is an unrolled Horner sum (a few microseconds).
+``keep`` of them); an evaluation is an unrolled Horner sum (a few microseconds), and
+:meth:`ChebyshevSegments.values` is the same sum over an array of times (numpy, the
+same operations in the same order: equal to the bit).
 """
 
 import math
@@ -42,6 +44,7 @@ class ChebyshevSegments:
         # the monomials in x of the interpolant at the nodes: coefficients = fit @ values
         self._fit = np.linalg.inv(np.vander(self._nodes, order + 1, increasing=True))
         self._segments = {}
+        self.components = int(components)
         self.value = compile_source(horner_source(order, components),
                                     f'<{name} horner {order}>', {
             'segments': self._segments, 'build': self.segment, 'floor': math.floor,
@@ -65,6 +68,27 @@ class ChebyshevSegments:
                 self._segments.clear()
             found = self._segments[k] = (middle, 1.0 / half, *coefficients.ravel().tolist())
         return found
+
+    def values(self, times):
+        """
+        Return the interpolant at ``times`` (s, an array): an (N, n) array.
+
+        :attr:`value` at each time, to the bit (the same Horner sum, by numpy).
+        """
+        times = np.asarray(times, float)
+        k = np.floor((times - self.origin) * (1.0 / self.span))
+        out = np.empty((times.size, self.components))
+        for key in (k[0],) if k.min() == k.max() else np.unique(k):
+            mask = slice(None) if k.min() == k.max() else k == key
+            found = self.segment(int(key))
+            coefficients = np.array(found[2:]).reshape(self.components, self.order + 1, 1)
+            x = (times[mask] - found[0]) * found[1]
+            total = np.repeat(coefficients[:, self.order], x.size, axis=1)   # (n, M)
+            for j in range(self.order - 1, -1, -1):
+                total *= x
+                total += coefficients[:, j]
+            out[mask] = total.T
+        return out
 
 
 def horner_source(order, components=3):

@@ -176,3 +176,7 @@ class IgrfField:
     def world(self, t, r=None):
         """Return B (T) in the world frame at time t (s) on the orbit, interpolated."""
         return self.world_at(t)
+
+    def world_many(self, times, r=None):
+        """Return B (T, world frame, (N, 3)) at ``times`` (s) on the orbit: :meth:`world`'s."""
+        return self.interpolant.values(times)

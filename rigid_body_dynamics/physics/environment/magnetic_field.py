@@ -22,6 +22,8 @@ pointing down, at the dipole's poles.
 
 import math
 
+import numpy as np
+
 #: IGRF-13 degree-1 Gauss coefficients at epoch 2020.0, [g10, g11, h11] (nT).
 IGRF13_2020 = (-29404.8, -1450.9, 4652.5)
 #: The IGRF reference radius (m).
@@ -76,3 +78,16 @@ class DipoleField:
         k = self._r3 / (r2 * rn)
         three = 3.0 * (dx * rx + dy * ry + dz * rz) / r2
         return (k * (three * rx - dx), k * (three * ry - dy), k * (three * rz - dz))
+
+    def world_many(self, times, r):
+        """Return B (T, world frame, (N, 3)) at ``times`` (s) and positions ``r`` (m, (N, 3))."""
+        theta = self.theta0 + self.rate * np.asarray(times, float)
+        c, s = np.cos(theta), np.sin(theta)
+        fx, fy, dz = self.dipole_fixed
+        dx, dy = c * fx - s * fy, s * fx + c * fy
+        rx, ry, rz = r[:, 0], r[:, 1], r[:, 2]
+        r2 = rx * rx + ry * ry + rz * rz
+        k = self._r3 / (r2 * np.sqrt(r2))
+        three = 3.0 * (dx * rx + dy * ry + dz * rz) / r2
+        return np.column_stack((k * (three * rx - dx), k * (three * ry - dy),
+                                k * (three * rz - dz)))

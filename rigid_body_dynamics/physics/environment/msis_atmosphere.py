@@ -36,7 +36,7 @@ import math
 
 import numpy as np
 
-from .atmosphere import air_flow, geodetic_latitude_height
+from .atmosphere import air_flow, air_flows, geodetic_latitude_height
 from .chebyshev import ChebyshevSegments
 from ...optional import require_for
 
@@ -123,9 +123,19 @@ class MsisAtmosphere:
         """Return rho (kg/m^3) at orbit time t (s) on the orbit, interpolated (``r`` unused)."""
         return math.exp(self._log_density(t))
 
+    def densities(self, times, r):
+        """Return :meth:`density` (kg/m^3, an (N,) array) at orbit ``times`` (s) on the orbit."""
+        if self.orbit is None:
+            return self.model(times, r)
+        return np.exp(self.interpolant.values(times)[:, 0])
+
     def flow(self, r, v):
         """Return the velocity relative to the air (m/s, world frame): v - omega_E x r."""
         return air_flow(self.earth_rate, r, v)
+
+    def flows(self, r, v):
+        """Return :meth:`flow` at many places: ``r`` (m) and ``v`` (m/s), (N, 3) arrays."""
+        return air_flows(self.earth_rate, r, v)
 
     def __str__(self):
         return (f'NRLMSIS {MSIS_VERSION} (F10.7 {self.f107:g} sfu, F10.7a {self.f107a:g} sfu, '

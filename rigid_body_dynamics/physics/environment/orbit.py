@@ -28,6 +28,8 @@ Control, section 6.3).
 
 import math
 
+import numpy as np
+
 #: Earth's gravitational parameter (m^3/s^2, EGM96 / WGS-84).
 MU_EARTH = 3.986004418e14
 #: Earth's equatorial radius (m, WGS-84): the default ``planet_radius``.
@@ -137,6 +139,36 @@ class KeplerOrbit:
         x, y = self.a * (c - self.e), self.a * self._b * s
         p, q = self.p_axis, self.q_axis
         return (x * p[0] + y * q[0], x * p[1] + y * q[1], x * p[2] + y * q[2])
+
+    def eccentric_anomalies(self, times):
+        """Return E (rad, in [0, 2 pi)) at ``times`` (s, an array): Newton to round-off."""
+        m = np.fmod(self.m0 + self.n * np.asarray(times, float), _TWO_PI)
+        m = np.where(m < 0.0, m + _TWO_PI, m)
+        e = self.e
+        if e == 0.0:
+            return m
+        big = m + e * np.sin(m) if e < 0.8 else np.full_like(m, math.pi)
+        for _ in range(50):
+            step = (big - e * np.sin(big) - m) / (1.0 - e * np.cos(big))
+            big = big - step
+            if np.all(np.abs(step) <= 4e-16 * (1.0 + np.abs(big))):
+                break
+        return big
+
+    def positions(self, times):
+        """Return r (m, world frame, (N, 3)) at ``times`` (s): :meth:`position` over an array."""
+        big = self.eccentric_anomalies(times)
+        x, y = self.a * (np.cos(big) - self.e), self.a * self._b * np.sin(big)
+        return np.outer(x, self.p_axis) + np.outer(y, self.q_axis)
+
+    def states(self, times):
+        """Return (r m, v m/s), (N, 3) arrays in the world frame, at ``times`` (s)."""
+        big = self.eccentric_anomalies(times)
+        c, s = np.cos(big), np.sin(big)
+        a, b = self.a, self._b
+        k = self._vscale / (a * (1.0 - self.e * c))
+        return (np.outer(a * (c - self.e), self.p_axis) + np.outer(a * b * s, self.q_axis),
+                np.outer(-k * s, self.p_axis) + np.outer(k * b * c, self.q_axis))
 
 
 def lvlh_axes(r, v):

@@ -24,6 +24,8 @@ the shadow's edge at a slant), which the cylindrical shadow of
 
 import math
 
+import numpy as np
+
 from .sun import in_shadow
 
 #: The Sun's nominal radius (m; IAU 2015 Resolution B3).
@@ -86,3 +88,42 @@ def sunlit_fraction(r, sun_position, planet_radius, model='cylindrical'):
     d = math.sqrt(sun_position[0] ** 2 + sun_position[1] ** 2 + sun_position[2] ** 2)
     sun = (sun_position[0] / d, sun_position[1] / d, sun_position[2] / d)
     return 0.0 if in_shadow(r, sun, planet_radius) else 1.0
+
+
+def sunlit_fractions(r, sun_position, planet_radius, model='cylindrical'):
+    """
+    Return :func:`sunlit_fraction` at many places: ``r`` and ``sun_position`` (m, (N, 3)).
+
+    The same formulas with numpy (an (N,) array); a body inside the planet or the Sun is
+    refused as there (ValueError).
+    """
+    rx, ry, rz = r[:, 0], r[:, 1], r[:, 2]
+    dx, dy, dz = sun_position[:, 0] - rx, sun_position[:, 1] - ry, sun_position[:, 2] - rz
+    body2 = rx * rx + ry * ry + rz * rz
+    sun = np.sqrt(dx * dx + dy * dy + dz * dz)
+    if model != 'conical':
+        d = np.sqrt(sun_position[:, 0] ** 2 + sun_position[:, 1] ** 2 + sun_position[:, 2] ** 2)
+        along = (rx * (sun_position[:, 0] / d) + ry * (sun_position[:, 1] / d)
+                 + rz * (sun_position[:, 2] / d))
+        dark = (along < 0.0) & (body2 - along * along < planet_radius * planet_radius)
+        return np.where(dark, 0.0, 1.0)
+    body = np.sqrt(body2)
+    if not (np.all(body > planet_radius) and np.all(sun > R_SUN)):
+        raise ValueError('a shadow needs a body outside the planet and the Sun')
+    a = np.arcsin(R_SUN / sun)
+    b = np.arcsin(planet_radius / body)
+    c = np.arccos(np.clip(-(rx * dx + ry * dy + rz * dz) / (body * sun), -1.0, 1.0))
+    light = np.ones_like(c)
+    edge = (c < a + b)
+    light[edge & (c <= b - a)] = 0.0
+    annular = edge & (c > b - a) & (c <= a - b)
+    light[annular] = (1.0 - (b * b) / (a * a))[annular]
+    part = edge & (c > b - a) & (c > a - b)
+    if np.any(part):
+        a, b, c = a[part], b[part], c[part]
+        x = (c * c + a * a - b * b) / (2.0 * c)
+        y = np.sqrt(np.maximum(0.0, a * a - x * x))
+        overlap = (a * a * np.arccos(np.clip(x / a, -1.0, 1.0))
+                   + b * b * np.arccos(np.clip((c - x) / b, -1.0, 1.0)) - c * y)
+        light[part] = np.clip(1.0 - overlap / (math.pi * a * a), 0.0, 1.0)
+    return light

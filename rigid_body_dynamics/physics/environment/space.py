@@ -8,6 +8,18 @@ attitude at that stage, and sums the torques of its models
 (:mod:`.torque_models`). It knows no model by name. When every model gives its
 torque as statements (:mod:`.stage_code`), the integrators put them into their
 generated stages, and a call runs the same statements compiled.
+
+The world quantities (the position, the field, the Sun, the air) depend on time
+alone, and the steps of a body fall on a grid (step k starts at k h): the generated
+stages ask for a whole step's nodes at once (:meth:`SpaceEnvironment.world_nodes`),
+and those come from a table computed a block of :data:`WORLD_BLOCK` steps at a time
+with numpy (:meth:`SpaceEnvironment.world_many`), the same formulas over arrays; in
+pure Python each node cost a dozen calls. The table's times are the stages' own to the
+bit (k h + c h); its values agree with :meth:`SpaceEnvironment.world_at` to a few
+units in the last place (numpy's sine and exponential are not the C library's; the
+Chebyshev sums of the orbit and the field are the same to the bit). A time off the
+grid, or a block that cannot be computed (an orbit SGP4 cannot fly a little ahead),
+is evaluated node by node as before, so an error comes at its own time.
 :class:`Disturbances` is what a body's environment is, as data (what the nodes'
 parameters say).
 """
@@ -15,14 +27,19 @@ parameters say).
 from dataclasses import dataclass
 import math
 
+import numpy as np
+
 from .facets import SOLAR_PRESSURE_1AU
 from .orbit import R_EARTH
-from .shadow import sunlit_fraction
+from .shadow import sunlit_fraction, sunlit_fractions
 from .stage_code import stage_code, torque_source
 from .sun import AU
 from ..dynamics.rk_kernels import compile_source
 
 _ZERO = (0.0, 0.0, 0.0)
+#: Steps per block of the world table (500 steps: about 1.5 ms of numpy for the whole
+#: mission model, once per 0.5 s of a 1 kHz body).
+WORLD_BLOCK = 500
 
 
 class Surroundings:
@@ -121,6 +138,8 @@ class SpaceEnvironment:
         # the world quantities by integrator time: an RK step evaluates a few times more than
         # once (a step's end is the next one's start, and the order is chosen at the start)
         self._world = {}
+        self._tables = {}              # (h, nodes) -> _WorldTable: a step grid's nodes
+        self._grid = None              # the table whose first node is 0: world_at reads it
         self._last = (None, None)      # (arguments, torque) of the last call
         #: the models as stage statements (None: one has none; they are then called)
         # where each world quantity starts in world_at's tuple: r and |r|^2, B, the Sun, the air
@@ -149,6 +168,10 @@ class SpaceEnvironment:
         if world is None:
             if not self._position:
                 return ()
+            if self._grid is not None:           # a step's start: the table's node 0
+                row = self._grid.row(t)
+                if row is not None:
+                    return tuple(row[:self.width])
             if len(self._world) > 32:
                 self._world.clear()
             s = t + self.epoch
@@ -166,6 +189,65 @@ class SpaceEnvironment:
                 world += self.atmosphere.flow(r, v) + (self.atmosphere.density(s, r),)
             world = self._world[t] = world
         return world
+
+    @property
+    def width(self):
+        """Return how many numbers :meth:`world_at` gives at one time."""
+        return (self._at_f + 4 * self._flow) if self._position else 0
+
+    def world_many(self, times):
+        """
+        Return :meth:`world_at` at integrator times ``times`` (s, an array): (N, width).
+
+        The same quantities, world frame, computed over the array (numpy); an orbit or a
+        field without an array method (``positions``, ``states``, ``world_many``) is
+        called at each time.
+        """
+        s = np.asarray(times, float) + self.epoch
+        orbit = self.orbit
+        if self._flow:
+            r, v = orbit.states(s) if hasattr(orbit, 'states') else (
+                np.array(part) for part in zip(*(orbit.state(x) for x in s)))
+        else:
+            r = orbit.positions(s) if hasattr(orbit, 'positions') else np.array(
+                [orbit.position(x) for x in s])
+        columns = [r, (r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1] + r[:, 2] * r[:, 2])[:, None]]
+        if self._field:
+            columns.append(self.field.world_many(s, r) if hasattr(self.field, 'world_many')
+                           else np.array([self.field.world(x, p) for x, p in zip(s, r)]))
+        if self._sun:
+            sun = self.sun.positions(s)
+            d = sun - r
+            distance = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2])
+            light = sunlit_fractions(r, sun, self.planet_radius, self.shadow)
+            columns += [d / distance[:, None],
+                        (SOLAR_PRESSURE_1AU * (AU / distance) ** 2 * light)[:, None]]
+        if self._flow:
+            columns += [self.atmosphere.flows(r, v), self.atmosphere.densities(s, r)[:, None]]
+        return np.hstack(columns)
+
+    def world_nodes(self, t, h, nodes):
+        """
+        Return :meth:`world_at` at t + c h for each c of ``nodes``, one flat sequence.
+
+        t (s) a step's start, h (s) its length, ``nodes`` the step's distinct nodes (a
+        tuple of floats): what the generated stages unpack at a step's start. From the
+        world table of (h, nodes) when t is on its grid (module docstring), else node by
+        node.
+        """
+        table = self._tables.get((h, nodes))
+        if table is None:
+            if len(self._tables) > 8:
+                self._tables.clear()
+            table = self._tables[h, nodes] = _WorldTable(self, h, nodes)
+            if nodes and nodes[0] == 0.0:
+                self._grid = table
+        row = table.row(t)
+        if row is None:
+            row = ()
+            for c in nodes:
+                row += self.world_at(t + c * h)
+        return row
 
     def _sunlight(self, s, r):
         """Return (s_x, s_y, s_z, P): the unit direction to the Sun from r (m) and P (N/m^2)."""
@@ -220,6 +302,45 @@ class SpaceEnvironment:
             a, b, c = model.torque(t, r, q, omega, env)
             tx, ty, tz = tx + a, ty + b, tz + c
         return tx, ty, tz
+
+
+class _WorldTable:
+    """
+    :meth:`SpaceEnvironment.world_many` at the nodes k h + c h of the steps of length h.
+
+    Computed :data:`WORLD_BLOCK` steps at a time; :meth:`row` is step k's quantities,
+    node after node (None off the grid, or where a block could not be computed).
+    """
+
+    def __init__(self, environment, h, nodes):
+        self.environment, self.h = environment, float(h)
+        self.offsets = np.array([c * h for c in nodes])
+        self._blocks = {}
+
+    def row(self, t):
+        """Return the quantities of the step that starts at t (s) = k h, or None."""
+        k = round(t / self.h)
+        if k * self.h != t:
+            return None
+        b = k // WORLD_BLOCK
+        block = self._blocks.get(b)
+        if block is None:
+            block = self._build(b)
+        return block[k - b * WORLD_BLOCK] if block else None
+
+    def _build(self, b):
+        k0 = b * WORLD_BLOCK
+        times = np.arange(k0, k0 + WORLD_BLOCK, dtype=float) * self.h
+        try:
+            values = self.environment.world_many(
+                (times[:, None] + self.offsets[None, :]).ravel())
+        except ValueError:          # (node by node, each error at its own time)
+            values = None
+        if len(self._blocks) > 4:
+            self._blocks.clear()
+        block = self._blocks[b] = (() if values is None else
+                                   values.reshape(WORLD_BLOCK, -1).tolist())
+        return block
 
 
 _COMPILED = {}

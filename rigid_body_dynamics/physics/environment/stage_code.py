@@ -8,10 +8,10 @@ costs. A torque model called at every stage (``torque(t, r, q, omega, env)``)
 costs a call, the shared quantities' call and a tuple per stage, several times its
 arithmetic. :class:`StageCode` puts the models' arithmetic into the stage instead:
 
-- at each distinct node t + c h of the step, one call ``world(t + c h)``
-  (:meth:`SpaceEnvironment.world_at <.space.SpaceEnvironment.world_at>`) gives
-  the world-frame position r (m), its squared norm and the field B (T): they
-  depend on time alone;
+- at the step's start, one call ``field.world_nodes(t, h, nodes)``
+  (:meth:`SpaceEnvironment.world_nodes <.space.SpaceEnvironment.world_nodes>`) gives
+  at each distinct node t + c h of the step the world-frame position r (m), its
+  squared norm, the field B (T), the Sun and the air: they depend on time alone;
 - at each stage, r and B are turned into the principal frame of the stage's
   attitude (not quite unit inside a step: the rotation of q / norm(q), as
   :func:`.space._to_body`), and each model's statements give its torque (N m,
@@ -88,6 +88,19 @@ class StageCode:
             comma = ',' if len(self.names) == 1 else ''
             lines.append(f'{indent}{", ".join(self.names)}{comma} = field.constants')
         return lines
+
+    def nodes_lines(self, nodes, indent='    '):
+        """
+        Statements once per step: the world quantities of every node, in one call.
+
+        ``nodes`` the step's distinct nodes c (in the order of their index j); the call is
+        ``field.world_nodes(t, h, nodes)`` (:meth:`.space.SpaceEnvironment.world_nodes`).
+        """
+        names = [name for j in range(len(nodes)) for name in self.world_names(j)]
+        if not names:
+            return []
+        literals = ''.join(f'{float(c)!r}, ' for c in nodes)
+        return [f'{indent}{", ".join(names)}, = field.world_nodes(t, h, ({literals.strip()}))']
 
     def node_lines(self, j, time, indent='    '):
         """Statements for node j at time expression ``time``: its world quantities."""

@@ -153,10 +153,11 @@ class SolarPressureTorque:
                     'kd': f.diffuse[k] / 3.0}
 
         def terms(v):
-            return [f'{p}e = {p}c * ({v["ks"]} * {p}c + {v["kd"]})',
-                    f'{p}ax += {v["kx"]} * {p}c', f'{p}ay += {v["ky"]} * {p}c',
-                    f'{p}az += {v["kz"]} * {p}c', f'{p}bx += {v["lx"]} * {p}e',
-                    f'{p}by += {v["ly"]} * {p}e', f'{p}bz += {v["lz"]} * {p}e']
+            lines = _sums(p, 'a', v, 'k', f'{p}c')
+            sums = _sums(p, 'b', v, 'l', f'{p}e')
+            inner = ' + '.join(term for term in (v['ks'] and f'{v["ks"]} * {p}c', v['kd'])
+                               if term)
+            return lines + ([f'{p}e = {p}c * ({inner})'] + sums if sums and inner else [])
         values, lines = _facet_lines(p, f, ('s_bx', 's_by', 's_bz'), constants, terms)
         lines.insert(0, f'{p}ax = {p}ay = {p}az = {p}bx = {p}by = {p}bz = 0.0')
         return values, lines, (f'-s_p * ({p}ay * s_bz - {p}az * s_by + {p}bx)',
@@ -201,8 +202,7 @@ class DragTorque:
                     'kz': half * f.centre[k][2]}
 
         def terms(v):
-            return [f'{p}ax += {v["kx"]} * {p}c', f'{p}ay += {v["ky"]} * {p}c',
-                    f'{p}az += {v["kz"]} * {p}c']
+            return _sums(p, 'a', v, 'k', f'{p}c')
         values, lines = _facet_lines(p, f, ('f_bx', 'f_by', 'f_bz'), constants, terms)
         lines.insert(0, f'{p}ax = {p}ay = {p}az = 0.0')
         return values, lines, (f'-f_rho * ({p}ay * f_bz - {p}az * f_by)',
@@ -217,27 +217,37 @@ def _facet_lines(p, facets, along, constants, terms):
     ``along``: the names of the stage's vector (the Sun's direction, the flow);
     ``constants(k)``: facet k's constants by short name; ``terms(names)``: the
     statements of a facet facing it, reading ``{p}c`` (the dot) and the facet's
-    constants by those names. Two facets whose normals are exact opposites (a box's
-    faces) share one dot: at most one of them faces the vector.
+    constants by those names (None for a constant that is exactly zero: its terms are
+    left out, as they add nothing). Two facets whose normals are exact opposites (a
+    box's faces) share one dot: at most one of them faces the vector.
     """
     normals = [tuple(float(c) for c in n) for n in facets.normal]
     values, lines, done = {}, [], set()
 
     def names(k):
-        mine = constants(k)
+        mine = {name: value for name, value in constants(k).items() if value != 0.0}
         values.update({f'{p}{name}{k}': value for name, value in mine.items()})
-        return {name: f'{p}{name}{k}' for name in mine}
+        return {name: f'{p}{name}{k}' if name in mine else None
+                for name in constants(k)}
     for k, n in enumerate(normals):
         if k in done:
             continue
-        values.update({f'{p}nx{k}': n[0], f'{p}ny{k}': n[1], f'{p}nz{k}': n[2]})
-        lines.append(f'{p}c = {p}nx{k} * {along[0]} + {p}ny{k} * {along[1]} + '
-                     f'{p}nz{k} * {along[2]}')
-        lines += [f'if {p}c > 0.0:'] + ['    ' + line for line in terms(names(k))]
+        dot = [(f'{p}n{axis}{k}', value, name)
+               for axis, value, name in zip('xyz', n, along) if value != 0.0]
+        values.update({variable: value for variable, value, _ in dot})
+        lines.append(f'{p}c = ' + ' + '.join(
+            f'{variable} * {name}' for variable, _, name in dot))
+        lines += [f'if {p}c > 0.0:'] + ['    ' + line for line in terms(names(k)) or ['pass']]
         back = next((j for j in range(k + 1, len(normals)) if j not in done
                      and normals[j] == (-n[0], -n[1], -n[2])), None)
         if back is not None:
             done.add(back)
             lines += [f'elif {p}c < 0.0:', f'    {p}c = -{p}c']
-            lines += ['    ' + line for line in terms(names(back))]
+            lines += ['    ' + line for line in terms(names(back)) or ['pass']]
     return values, lines
+
+
+def _sums(p, total, names, letter, factor):
+    """Return the statements ``{p}{total}x += {constant} * {factor}`` (x, y, z) of nonzero ones."""
+    return [f'{p}{total}{axis} += {names[letter + axis]} * {factor}'
+            for axis in 'xyz' if names[letter + axis] is not None]

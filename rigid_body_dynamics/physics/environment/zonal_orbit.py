@@ -222,3 +222,11 @@ class ZonalOrbit:
     def state(self, t):
         """Return (r m, v m/s), tuples in the world frame, at time t (s)."""
         return self.position(t), self.velocity(t)
+
+    def positions(self, times):
+        """Return r (m, world frame) at ``times`` (s, an array), (N, 3): :meth:`position`'s."""
+        return self._position.values(times)
+
+    def states(self, times):
+        """Return (r m, v m/s), (N, 3) arrays in the world frame, at ``times`` (s)."""
+        return self._position.values(times), self._velocity.values(times)
