@@ -142,10 +142,11 @@ def engine_steps(steps=20000):
         f'{mission / dipole:.2f}x the step with the gravity gradient, the dipole field and '
         f'the residual dipole ({mission * 1e6:.1f} against {dipole * 1e6:.1f} us, this run); '
         f'with NRLMSIS 2.1 for the air {msis / dipole:.2f}x ({msis * 1e6:.1f} us). '
-        'What the statements leave: the orbit and '
-        'the field at each distinct stage time (5 in an order-6 step; they depend on time '
-        'alone), and the turn of the position and the field into the attitude of each '
-        'stage. The CPU of the node moves from run to run and day to day on this 2-core '
+        'What the statements leave: the world quantities at the 5 distinct nodes of an '
+        'order-6 step (they depend on time alone; one call per step reads them from the '
+        'table the environment computes 500 steps at a time with numpy), and the turn of '
+        'the position, the field, the Sun and the flow into the attitude of each stage. '
+        'The CPU of the node moves from run to run and day to day on this 2-core '
         'virtual machine (the free body alone measured 0.034 to 0.064 of a core in three '
         'runs on 2026-12-03), so the step of the engine is the steadier figure.']
 

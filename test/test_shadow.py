@@ -7,9 +7,9 @@ across the Sun's disc with scipy's quad (split where the circles cross), not
 by the closed form's lens area. Geometries are drawn around the shadow's edge for a 400 km
 orbit (a ~ 4.65e-3 rad, b ~ 1.22 rad) and for made-up radii where the planet
 is smaller than the Sun (the annular case). Across the low orbit's penumbra the
-closed form and the integration differ by 5.8e-9 at most (the planet's disc,
-1.2 rad across, against the Sun's 0.005: the chords' kinks are sharp for quad),
-in the annular case by 6.3e-13.
+closed form and the integration differ by 1.2e-13 at most (the closed form's
+angles by atan2: by acos, as Montenbruck and Gill write them, the planet's angle
+lost seven digits and the two differed by 5.8e-9), in the annular case by 6.3e-13.
 
 The sun sensor in the conical shadow is held to the cones' own geometry: the
 umbra and penumbra cones tangent to the Sun and the Earth, crossed by a circular
@@ -74,7 +74,7 @@ def test_the_penumbra_of_a_low_orbit_equals_the_discs_overlap():
         r, sun, sun_radius = _geometry(a, b, c, AU)
         got = conical_shadow_fraction(r, sun, R_EARTH, sun_radius)
         worst = max(worst, abs(got - _uncovered(a, b, c)))
-    assert worst < 2e-8, worst           # delivered 5.8e-9 (the target was 1e-6)
+    assert worst < 3e-13, worst          # delivered 1.2e-13 (the target was 1e-6)
 
 
 def test_an_annular_eclipse_and_its_partial_phases_equal_the_discs_overlap():

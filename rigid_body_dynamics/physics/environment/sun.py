@@ -76,7 +76,16 @@ def sun_direction_almanac(jd):
     The Astronomical Almanac's low-precision formula (module docstring), seen from
     the Earth's centre.
     """
-    d = jd - JD_J2000
+    return sun_direction_days(jd - JD_J2000)
+
+
+def sun_direction_days(d):
+    """
+    Return :func:`sun_direction_almanac` ``d`` days (TT ~ UTC) from J2000.0.
+
+    The days themselves: a Julian date near 2.46e6 resolves 40 us, in which the Sun
+    turns 8e-12 rad; the days from J2000.0 resolve 1e-12 days (0.1 us).
+    """
     g = math.radians((357.528 + 0.9856003 * d) % 360.0)
     lam = math.radians((280.460 + 0.9856474 * d) % 360.0
                        + 1.915 * math.sin(g) + 0.020 * math.sin(2.0 * g))
@@ -102,7 +111,11 @@ def sun_position_almanac(jd):
     :func:`sun_direction_almanac` times :func:`sun_distance_almanac`, their mean
     anomaly computed once (the stages ask for it at every distinct time).
     """
-    d = jd - JD_J2000
+    return sun_position_days(jd - JD_J2000)
+
+
+def sun_position_days(d):
+    """Return :func:`sun_position_almanac` ``d`` days from J2000.0 (the days as there)."""
     g = math.radians((357.528 + 0.9856003 * d) % 360.0)
     sin_g, cos_g = math.sin(g), math.cos(g)
     lam = math.radians((280.460 + 0.9856474 * d) % 360.0
@@ -113,14 +126,8 @@ def sun_position_almanac(jd):
     return (r * math.cos(lam), math.cos(eps) * s, math.sin(eps) * s)
 
 
-def sun_positions_almanac(d):
-    """
-    Return the Sun's positions (m, world, (N, 3)) ``d`` days from J2000.0 (an array).
-
-    :func:`sun_position_almanac` over an array, of the days from J2000.0 rather than
-    the Julian date (a Julian date near 2.46e6 resolves 40 us, in which the Sun turns
-    8e-12 rad; the days from J2000.0 resolve 0.1 us).
-    """
+def sun_positions_days(d):
+    """Return :func:`sun_position_days` at ``d`` (days from J2000.0, an array): (N, 3) m."""
     d = np.asarray(d, float)
     g = np.radians(np.remainder(357.528 + 0.9856003 * d, 360.0))
     sin_g, cos_g = np.sin(g), np.cos(g)
@@ -164,24 +171,23 @@ class Sun:
         """Return the unit vector to the Sun (world frame) at simulated time t (s)."""
         if self.fixed is not None:
             return self.fixed
-        return sun_direction_almanac(self.jd0 + t / _DAY)
+        return sun_direction_days(self.days0 + t / _DAY)
 
     def position(self, t):
         """Return where the Sun is (m, world, from the Earth's centre) at time t (s)."""
         if self.fixed is not None:
             return (AU * self.fixed[0], AU * self.fixed[1], AU * self.fixed[2])
-        return sun_position_almanac(self.jd0 + t / _DAY)
+        return sun_position_days(self.days0 + t / _DAY)
 
     def positions(self, times):
         """
         Return where the Sun is (m, world, (N, 3)) at ``times`` (s, an array).
 
-        The almanac's position (:func:`sun_positions_almanac`) interpolated on
+        The almanac's position (:func:`sun_positions_days`) interpolated on
         day-long segments by Chebyshev polynomials of degree 10 (:mod:`.chebyshev`):
-        the Sun turns 0.017 rad in a day, and the interpolant is the formula to
-        round-off (``test_sun``), at a third of its cost over an array. It is
-        smoother than :meth:`position`, whose Julian date resolves 40 us (2e-11 of
-        the distance apart).
+        the Sun turns 0.017 rad in a day, and the interpolant is :meth:`position` to
+        round-off (``test_environment``), at a third of the formula's cost over an
+        array.
         """
         times = np.asarray(times, float)
         if self.fixed is not None:
@@ -189,7 +195,7 @@ class Sun:
         if self._interpolant is None:
             from .chebyshev import ChebyshevSegments
             self._interpolant = ChebyshevSegments(
-                lambda middle, nodes: sun_positions_almanac(self.days0 + nodes / _DAY), _DAY, 10,
+                lambda middle, nodes: sun_positions_days(self.days0 + nodes / _DAY), _DAY, 10,
                 keep=4, name='sun')
         return self._interpolant.values(times)
 

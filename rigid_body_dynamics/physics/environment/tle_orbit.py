@@ -25,6 +25,8 @@ Positions in m, velocities in m/s, time t in s from simulated time 0, which is
 from datetime import datetime, timezone
 import math
 
+import numpy as np
+
 from .sun import JD_UNIX, unix_time
 from ...optional import require_for
 
@@ -126,6 +128,27 @@ class TleOrbit:
     def position(self, t):
         """Return r (m, world frame: TEME) at time t (s)."""
         return self.state(t)[0]
+
+    def states(self, times):
+        """
+        Return (r m, v m/s), (N, 3) arrays in TEME, at ``times`` (s): SGP4 over the array.
+
+        ``Satrec.sgp4_array`` at the TLE's epoch day plus the fraction of the time: the
+        same SGP4 as :meth:`state` at a time rounded to 1e-11 s (1e-14 of the position
+        apart). Raises ValueError as :meth:`state` where SGP4 cannot fly.
+        """
+        s = self.satellite
+        times = np.asarray(times, float)
+        fraction = s.jdsatepochF + (self.tsince0 + times / 60.0) / 1440.0
+        error, r, v = s.sgp4_array(np.full(times.size, s.jdsatepoch), fraction)
+        if np.any(error):
+            bad = int(np.argmax(error != 0))
+            self.state(float(times[bad]))        # raises with SGP4's reason
+        return r * 1e3, v * 1e3
+
+    def positions(self, times):
+        """Return r (m, TEME, (N, 3)) at ``times`` (s): :meth:`states`' positions."""
+        return self.states(times)[0]
 
     def summary(self):
         """Return a line that says which orbit this is (for the node's log)."""
