@@ -15,8 +15,8 @@ shadow) on a 3U CubeSat's six faces. CPU is the
 simulator's share of one core over 8 s after 3 s of warm-up, each case three times,
 alternating. Then the engine's step alone (``BodySimulation.advance`` on a fake clock, the
 least of five runs of 20000 steps, in five rounds over all the cases), free, under a
-constant torque, and in the same environments, the body alone and with four pyramid wheels (J = 0.01 kg m^2, Coulomb 1e-4 N m
-and viscous 1e-6 N m s friction, spinning at (40, -25, 10, 0.5) rad/s, motors idle: without
+constant torque, and in the same environments, the body alone and with four pyramid
+wheels (J = 0.01 kg m^2, Coulomb 1e-4 N m and viscous 1e-6 N m s friction, spinning at (40, -25, 10, 0.5) rad/s, motors idle: without
 the orbit's torques, their steps between two reads of the state, every 10, are one span); in
 orbit each twice: with the models' statements in the generated stages (as the package runs)
 and with the models called at every stage (``SpaceEnvironment(...,
