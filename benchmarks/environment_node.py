@@ -2,25 +2,25 @@
 attitude_simulator in orbit: CPU at 1 kHz, free against the space environment.
 
 The asymmetric body I = (2, 3, 1.2) kg m^2 tumbling at omega0 = (0.3, -0.5, 0.8) rad/s, 1 kHz
-steps, 100 Hz publishing, real time: free (no orbit), on a 500 km circular orbit with
-nothing acting (the exact torque-free flow still serves), with the gravity gradient,
-and with the gravity gradient, the dipole field, a residual dipole and a magnetometer
-at 10 Hz (every stage evaluates the orbit, the field and the torques); the engine's step
-also with the IGRF-14 to degree 13 instead of the dipole (interpolated along the orbit), on
-the Kepler orbit and on the ISS's TLE (SGP4, epoch 2019-12-09T20:42:00Z); and the whole
-mission model: the orbit integrated under J2, the IGRF-14 to degree 13, the gravity
-gradient, the residual dipole, and drag (Vallado's exponential air, and again NRLMSIS 2.1's
-at F10.7 150, Ap 4) and solar pressure (the Almanac's Sun from the epoch, the conical
-shadow) on a 3U CubeSat's six faces. CPU is the
-simulator's share of one core over 8 s after 3 s of warm-up, each case three times,
+steps, 100 Hz publishing, real time: free (no orbit), on a 500 km circular orbit with nothing
+acting (the exact torque-free flow still serves), with the gravity gradient, and with the
+gravity gradient, the dipole field, a residual dipole and a magnetometer at 10 Hz (every stage
+evaluates the orbit, the field and the torques); the engine's step also with the IGRF-14 to
+degree 13 instead of the dipole (interpolated along the orbit), on the Kepler orbit and on the
+ISS's TLE (SGP4, epoch 2019-12-09T20:42:00Z); and the whole mission model: the orbit
+integrated under J2, the IGRF-14 to degree 13, the gravity gradient, the residual dipole, and
+drag (Vallado's exponential air, and again NRLMSIS 2.1's at F10.7 150, Ap 4) and solar
+pressure (the Almanac's Sun from the epoch, the conical shadow) on a 3U CubeSat's six faces.
+CPU is the simulator's share of one core over 8 s after 3 s of warm-up, each case three times,
 alternating. Then the engine's step alone (``BodySimulation.advance`` on a fake clock, the
-least of five runs of 20000 steps, in five rounds over all the cases), free, under a
-constant torque, and in the same environments, the body alone and with four pyramid
-wheels (J = 0.01 kg m^2, Coulomb 1e-4 N m and viscous 1e-6 N m s friction, spinning at (40, -25, 10, 0.5) rad/s, motors idle: without
-the orbit's torques, their steps between two reads of the state, every 10, are one span); in
-orbit each twice: with the models' statements in the generated stages (as the package runs)
-and with the models called at every stage (``SpaceEnvironment(...,
-stages=False)``, the path of a model without statements). ``./dev bench --only environment-node``.
+least of five runs of 20000 steps, in five rounds over all the cases), free, under a constant
+torque, and in the same environments, the body alone and with four pyramid wheels (J = 0.01 kg
+m^2, Coulomb 1e-4 N m and viscous 1e-6 N m s friction, spinning at (40, -25, 10, 0.5) rad/s,
+motors idle: without the orbit's torques, their steps between two reads of the state, every
+10, are one span); in orbit each twice: with the models' statements in the generated stages
+(as the package runs) and with the models called at every stage (``SpaceEnvironment(...,
+stages=False)``, the path of a model without statements). ``./dev bench --only
+environment-node``.
 """
 
 import statistics
