@@ -206,3 +206,46 @@ def test_world_nodes_on_the_grid_come_from_the_table_and_off_it_from_world_at():
     k = 3 * WORLD_BLOCK + 1
     assert tuple(env.world_nodes(k * h, h, NODES)) == tuple(
         x for c in NODES for x in env.world_at(k * h + c * h))
+
+
+def test_a_new_environment_of_the_same_world_keeps_the_table(monkeypatch):
+    """
+    A magnetorquer command makes the plant a new environment; its table is not computed again.
+
+    The mission model with a dipole command every 10 steps, 1200 steps of 1 ms: the
+    world is computed once per block of WORLD_BLOCK steps (three blocks), not once per
+    command (120). An environment of another world (another epoch) starts its own table.
+    """
+    from rigid_body_dynamics.engine import BodySimulation, Disturbances
+    from rigid_body_dynamics.physics import Inertia
+    name, mission = _cases()[5]
+    calls = []
+    original = SpaceEnvironment.world_many
+
+    def counted(self, times):
+        calls.append(len(times))
+        return original(self, times)
+    monkeypatch.setattr(SpaceEnvironment, 'world_many', counted)
+    body = BodySimulation(Inertia((2.0, 3.0, 1.2)), 'exact', 1000.0,
+                          ((0.0, 0.0, 0.0, 1.0), (0.3, -0.5, 0.8)), publish_every=10,
+                          disturbances=Disturbances(
+                              orbit=mission.orbit, field=mission.field, gravity_gradient=True,
+                              sun=mission.sun, shadow_model='conical',
+                              facets=mission.models[2].facets, solar_pressure=True,
+                              atmosphere=mission.atmosphere, drag=True))
+    outbox = []
+    with body.lock:
+        for i in range(1200):
+            if i % 10 == 0:
+                body.plant.set_dipole((0.1 * (i % 3), 0.05, -0.02))
+            body.advance(0, outbox)
+    assert len(calls) == 3, calls
+    other = SpaceEnvironment(mission.orbit, mission.field, mission.models, epoch=5.0,
+                             sun=mission.sun, shadow='conical', atmosphere=mission.atmosphere)
+    other.adopt_world(body.plant.field)
+    assert other._tables == {} and other._grid is None
+    again = SpaceEnvironment(mission.orbit, mission.field, mission.models,
+                             epoch=body.plant.field.epoch, sun=mission.sun, shadow='conical',
+                             atmosphere=mission.atmosphere)
+    again.adopt_world(body.plant.field)
+    assert again._tables is body.plant.field._tables

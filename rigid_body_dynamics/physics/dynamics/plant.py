@@ -99,11 +99,14 @@ class Plant:
         if d.drag:
             models.append(DragTorque(d.facets.turned(self.principal)))
         # the stepper's time starts at 0 when it is made: the environment is told the offset
+        previous = getattr(self, 'field', None)
         self.field = SpaceEnvironment(
             d.orbit, d.field, models, epoch=(self.steps - self.stepper.steps) * self.dt,
             sun=d.sun, shadow=d.shadow_model, planet_radius=d.planet_radius,
             atmosphere=d.atmosphere) \
             if models else None
+        if self.field is not None:
+            self.field.adopt_world(previous)
 
     def principal(self, vector):
         """Return a body-frame vector (3 numbers) in the principal frame, a tuple of floats."""
