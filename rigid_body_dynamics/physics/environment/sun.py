@@ -186,7 +186,7 @@ class Sun:
         The almanac's position (:func:`sun_positions_days`) interpolated on
         day-long segments by Chebyshev polynomials of degree 10 (:mod:`.chebyshev`):
         the Sun turns 0.017 rad in a day, and the interpolant is :meth:`position` to
-        round-off (``test_environment``), at a third of the formula's cost over an
+        round-off (``test_world_table``), at a third of the formula's cost over an
         array.
         """
         times = np.asarray(times, float)
