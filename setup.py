@@ -36,6 +36,7 @@ setup(
             'attitude_estimator = rigid_body_dynamics.nodes.entry:estimator',
             'rigid_body_report = rigid_body_dynamics.tools.report:main',
             'rigid_body_analyze = rigid_body_dynamics.tools.analyze:main',
+            'rigid_body_campaign = rigid_body_dynamics.tools.campaign:main',
         ],
         # fixtures for users' topic-based tests; inert unless a test asks for them
         'pytest11': ['rigid_body_dynamics = rigid_body_dynamics.testing'],

@@ -3,7 +3,8 @@ The third-party modules that only some tools need, and the one-line error when o
 
 The nodes and the physics need numpy, scipy and the ROS messages only. The
 report needs matplotlib and plotly, the bag tools rosbags, an orbit from a TLE
-(``orbit_tle``) sgp4, the IGRF field ppigrf, the NRLMSIS density pymsis; a ROS
+(``orbit_tle``) sgp4, the IGRF field ppigrf, the NRLMSIS density pymsis, a campaign on
+Dask Dask's distributed; a ROS
 user who never runs them may not have them (plotly has no rosdep key, so ``rosdep install``
 cannot bring it). A tool calls :func:`require` first, before any work, and a
 missing module ends it with one line saying what to install and exit status 2,
@@ -22,6 +23,7 @@ OPTIONAL = {
     'ppigrf': (None, 'pip install ppigrf', None),
     'sgp4': ('sudo apt install python3-sgp4', 'pip install sgp4', None),
     'pymsis': (None, 'pip install pymsis', None),
+    'distributed': ('sudo apt install python3-distributed', 'pip install distributed', None),
 }
 
 

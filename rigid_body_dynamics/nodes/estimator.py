@@ -40,7 +40,7 @@ from .environment_parameters import environment_params, field_from, orbit_from
 from .sensor_parameters import sensor_params, sun_from
 from .simulator_parameters import PARAMETERS as SIMULATOR
 from ..physics import quaternions as quat
-from ..physics.mekf import MEKF
+from ..physics.mekf_fusion import MekfFusion
 from ..ros import conversions as conv
 from ..ros.parameters import ConfigurationError, Param, ParameterTable
 from ..ros.runner import run
@@ -106,11 +106,15 @@ class AttitudeEstimator(Node):
         super().__init__(NODE_NAME, **kwargs)
         v = self._values = PARAMETERS.validate(PARAMETERS.declare(self))
         self._world, self._body = v['world_frame'], v['body_frame']
-        self._bias_sigma = v['initial_bias_sigma'] or v['gyro_turn_on_bias']
+        self.fusion = MekfFusion(
+            v['gyro_noise_density'], v['gyro_bias_random_walk'], v['tracker_covariance'],
+            v['initial_bias_sigma'] or v['gyro_turn_on_bias'], sun=v['sun'],
+            sun_noise=v['sun_sensor_noise'], field=v['field'], orbit=v['orbit'],
+            magnetometer_noise=v['magnetometer_noise'])
         self._pending = []            # heap of (stamp ns, kind order, sequence, kind, data)
         self._sequence = 0
-        self.counts = dict.fromkeys(('gyro', 'star_tracker', 'sun_sensor', 'magnetometer',
-                                     'late', 'gyro gaps', 'restarts'), 0)
+        # the fusion counts the readings it takes; the node counts gaps and restarts
+        self._node_counts = {'gyro gaps': 0, 'restarts': 0}
         self._restart()
         self._pub = self.create_publisher(PoseWithCovarianceStamped, 'attitude_estimate',
                                           STATE_QOS)
@@ -136,14 +140,16 @@ class AttitudeEstimator(Node):
 
     def _restart(self):
         """Forget the estimate (at start, and when the stamps go back: a simulator reset)."""
-        v = self._values
-        self.filter = MEKF(v['gyro_noise_density'], v['gyro_bias_random_walk'])
-        self._time = None          # the filter's stamp (ns)
-        self._gyro = None          # (stamp ns, measured rate) of the last gyro sample
+        self.fusion.restart()
         self._newest = None
         # the shortest interval between gyro stamps seen (ns): a reset simulator may sample
         # at another rate
         self._gyro_interval = None
+
+    @property
+    def counts(self):
+        """Readings used per kind, gyro samples, late readings, gyro gaps and restarts."""
+        return {**self.fusion.counts, **self._node_counts}
 
     # ---------------------------------------------------------------- intake
     def _queue(self, msg, kind):
@@ -154,7 +160,7 @@ class AttitudeEstimator(Node):
     def _on_imu(self, msg):
         stamp = conv.time_ns(msg.header.stamp)
         if self._newest is not None and stamp < self._newest:
-            self.counts['restarts'] += 1
+            self._node_counts['restarts'] += 1
             self.get_logger().info('the gyro stamps went back (a reset): the estimate restarts')
             # what is still pending at or after the last gyro stamp came from the run before
             # the reset; what came since, stamped before this sample, is too early to use
@@ -177,86 +183,54 @@ class AttitudeEstimator(Node):
                 moved = self._propagate(stamp, np.array(data)) or moved
             else:
                 moved = self._update(stamp, kind, data) or moved
-        if moved and self.filter.started:
+        if moved and self.fusion.started:
             self._publish()
 
     def _propagate(self, stamp, omega):
         """Propagate to a gyro sample's stamp with the previous sample's rate (held)."""
-        last, self._gyro = self._gyro, (stamp, omega)
-        self.counts['gyro'] += 1
+        last = self.fusion.last_gyro
         if last is not None and stamp > last[0]:
             self._check_gap(stamp - last[0])
-        if not self.filter.started:
-            return False
-        held = omega if last is None else last[1]
-        self.filter.propagate(held, (stamp - self._time) * 1e-9)
-        self._time = stamp
-        return True
+        return self.fusion.gyro(stamp, omega)
 
     def _check_gap(self, interval):
         """Count (and warn of) a gyro interval over GAP times the shortest seen (ns)."""
         shortest = self._gyro_interval = min(interval, self._gyro_interval or interval)
         if interval > GAP * shortest:
-            self.counts['gyro gaps'] += 1
+            self._node_counts['gyro gaps'] += 1
             self.get_logger().warning(
                 f'gyro readings missing: {interval * 1e-6:.3g} ms between two where '
-                f'{shortest * 1e-6:.3g} ms is usual ({self.counts["gyro gaps"]} gaps so far); '
+                f'{shortest * 1e-6:.3g} ms is usual ({self._node_counts["gyro gaps"]} gaps so '
+                'far); '
                 'the estimate holds the rate across them and is worse than it says (a busy '
                 'machine? a deeper queue: qos_overrides./imu.subscription.depth)',
                 throttle_duration_sec=5.0)
 
     def _update(self, stamp, kind, msg):
         """Correct with one reading at its stamp (after propagating to it); False if not used."""
-        f = self.filter
-        if not f.started:
-            if kind != 'star_tracker':
-                return False
-            o = msg.pose.pose.orientation
-            v = self._values
-            f.start((o.x, o.y, o.z, o.w), self._values['tracker_covariance'],
-                    bias_sigma=self._bias_sigma)
-            self._time = stamp
-            self.counts[kind] += 1
-            self.get_logger().info(f'started at {stamp * 1e-9:.3f} s from the star tracker; '
-                                   f'bias 1 sigma {self._bias_sigma:g} rad/s, magnetometer '
-                                   f'noise {v["magnetometer_noise"]:g} T')
-            return True
-        if stamp < self._time:
-            self.counts['late'] += 1
-            return False
-        if stamp > self._time and self._gyro is not None:   # between two gyro samples
-            f.propagate(self._gyro[1], (stamp - self._time) * 1e-9)
-            self._time = stamp
-        if not self._correct(stamp, kind, msg):
-            return False
-        self.counts[kind] += 1
-        return True
-
-    def _correct(self, stamp, kind, msg):
-        """Apply a reading of ``kind``; False when the model it needs is not configured."""
-        f, v, t = self.filter, self._values, stamp * 1e-9
         if kind == 'star_tracker':
             o = msg.pose.pose.orientation
-            f.update_attitude((o.x, o.y, o.z, o.w), v['tracker_covariance'])
+            value = (o.x, o.y, o.z, o.w)
         elif kind == 'sun_sensor':
-            if v['sun'] is None or not v['sun_sensor_noise']:
-                return False
             s = msg.vector
-            f.update_vector((s.x, s.y, s.z), v['sun'].direction(t), v['sun_sensor_noise'] ** 2)
+            value = (s.x, s.y, s.z)
         else:
-            if v['field'] is None or not v['magnetometer_noise']:
-                return False
             b = msg.magnetic_field
-            world = v['field'].world(t, v['orbit'].position(t))
-            size = math.sqrt(sum(c * c for c in world))
-            # the reading's noise as an angle: sigma / norm(B)
-            f.update_vector((b.x, b.y, b.z), world, (v['magnetometer_noise'] / size) ** 2)
+            value = (b.x, b.y, b.z)
+        started = self.fusion.started
+        if not self.fusion.reading(stamp, kind, value):
+            return False
+        if not started:
+            self.get_logger().info(
+                f'started at {stamp * 1e-9:.3f} s from the star tracker; bias 1 sigma '
+                f'{self.fusion.bias_sigma:g} rad/s, magnetometer noise '
+                f'{self._values["magnetometer_noise"]:g} T')
         return True
 
     # ---------------------------------------------------------------- output
     def _publish(self):
-        f, msg = self.filter, self._estimate
-        msg.header.stamp = conv.time_msg(self._time)
+        f, msg = self.fusion.filter, self._estimate
+        msg.header.stamp = conv.time_msg(self.fusion.time)
         msg.pose.pose.orientation = conv.quaternion_msg(f.q)
         cov = np.zeros((6, 6))
         cov[:3, :3] = np.eye(3) * UNMEASURED
@@ -269,7 +243,7 @@ class AttitudeEstimator(Node):
         self._pub_bias.publish(bias)
 
     def _diagnose(self):
-        f = self.filter
+        f = self.fusion.filter
         if f.started:
             sigma = np.sqrt(np.diag(f.P))
             level, message = DiagnosticStatus.OK, (

@@ -45,8 +45,8 @@ from std_msgs.msg import Float64, Float64MultiArray
 from std_srvs.srv import SetBool, Trigger
 
 from .simulator_diagnostics import SimulatorReport
-from .simulator_parameters import PARAMETERS, state_topics
-from ..engine import BodySimulation, Lockstep, Loop, Member, Pace
+from .simulator_parameters import body_from, PARAMETERS, state_topics
+from ..engine import Lockstep, Loop, Member, Pace
 from ..physics import presets
 from ..ros import simulator_interface
 from ..ros.command_decoder import decode_dipoles, decode_wheels, steady_times, TorqueDecoder
@@ -133,16 +133,7 @@ class AttitudeSimulator(Node):
         self._warnings = ThrottledWarnings(self.get_logger())
         start_ns = 0 if self._publish_clock else self.get_clock().now().nanoseconds
         self.lockstep = values['lockstep']
-        self.body = BodySimulation(
-            values['body'], values['integrator'], rate,
-            (values['initial_orientation'], values['initial_angular_velocity']),
-            0.0 if self.lockstep else values['torque_timeout'], values['max_torque'],
-            self._publish_every(values['publish_rate']), start_ns,
-            sensors=values['sensors'], seed=values['noise_seed'],
-            disturbances=values['disturbances'],
-            wheels=values['wheels'], wheel_speeds=values['wheel_speeds'],
-            magnetorquers=values['magnetorquer_max_dipole']
-            if values['disturbances'].field is not None else None)
+        self.body = body_from(values, self._publish_every(values['publish_rate']), start_ns)
         self._lvlh_frame = prefix + values['lvlh_frame']
         self._publish_rate = values['publish_rate']
         self._decoder = TorqueDecoder(self._frames)

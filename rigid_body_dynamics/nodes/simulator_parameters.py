@@ -11,6 +11,7 @@ import math
 from .environment_parameters import environment_from, environment_params
 from .sensor_parameters import sensor_params, sensors_from
 from .wheel_parameters import WHEEL_PARAMS, wheel_params, wheels_from
+from ..engine import BodySimulation
 from ..physics import Inertia, INTEGRATORS, presets
 from ..physics.dynamics.gyrostat import GyrostatIntegrator
 from ..physics.dynamics.integrators import REMOVED as REMOVED_INTEGRATORS
@@ -287,3 +288,22 @@ def _preset_name(name):
         except ValueError as err:
             raise ConfigurationError(str(err)) from None
     return name
+
+
+def body_from(values, publish_every, start_ns=0):
+    """
+    Return the engine's BodySimulation of a simulator's validated ``values``.
+
+    ``publish_every``: integration steps per published state; ``start_ns``: the
+    stamp of simulated time 0 (int ns). In lockstep the torque watchdog is off
+    (a tick waits for its command instead).
+    """
+    return BodySimulation(
+        values['body'], values['integrator'], values['integration_rate'],
+        (values['initial_orientation'], values['initial_angular_velocity']),
+        0.0 if values['lockstep'] else values['torque_timeout'], values['max_torque'],
+        publish_every, start_ns, sensors=values['sensors'], seed=values['noise_seed'],
+        disturbances=values['disturbances'],
+        wheels=values['wheels'], wheel_speeds=values['wheel_speeds'],
+        magnetorquers=values['magnetorquer_max_dipole']
+        if values['disturbances'].field is not None else None)

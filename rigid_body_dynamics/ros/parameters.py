@@ -204,6 +204,28 @@ class ParameterTable:
         """Return the current raw values of the table's parameters on ``node``."""
         return {name: node.get_parameter(name).value for name in self.params}
 
+    def resolve(self, given):
+        """
+        Return every parameter's raw value without a node: ``given``'s, else the default.
+
+        ``given``: name -> value, as a parameters file sets them. Defaults that
+        depend on another parameter (a preset's inertia) read the values resolved
+        before them, in declaration order, as a node's declaration does. A name the
+        table does not have is refused (ConfigurationError): a misspelt name must
+        not leave the default in its place.
+        """
+        unknown = sorted(set(given) - set(self.params))
+        if unknown:
+            raise ConfigurationError(f'unknown parameter(s) {", ".join(unknown)}')
+        values = {}
+        source = _Resolved(values)
+        for p in self.params.values():
+            if p.name in given:
+                values[p.name] = given[p.name]
+            else:
+                values[p.name] = p.default(source) if callable(p.default) else p.default
+        return values
+
     def validate(self, values):
         """Convert and check ``values`` (name -> raw value); ConfigurationError says why."""
         out = {name: self.params[name].check(value) for name, value in values.items()
@@ -223,6 +245,22 @@ class ParameterTable:
         return '\n'.join(['| name | type | default | range | read-only | meaning |',
                           '| --- | --- | --- | --- | --- | --- |']
                          + [p.row() for p in self.params.values()])
+
+
+class _Resolved:
+    """The values resolved so far, read as a node's parameters (``get_parameter(name).value``)."""
+
+    def __init__(self, values):
+        self._values = values
+
+    def get_parameter(self, name):
+        """Return the resolved value of ``name`` as an object with ``value``."""
+        return _Value(self._values[name])
+
+
+@dataclass(frozen=True)
+class _Value:
+    value: object
 
 
 def write_parameters_file(sections):

@@ -605,6 +605,22 @@ def autocorrelation_time(x):
     return max(1.0, tau)
 
 
+def attitude_nees(q_true, q_est, covariances):
+    """
+    Return the attitude errors (..., 3; rad, world frame) and their NEES (...,).
+
+    ``q_true``, ``q_est`` (..., 4) x, y, z, w body -> world; ``covariances``
+    (..., 3, 3) rad^2 about the world's fixed axes. The error is the rotation
+    vector of q_est q_true^-1; NEES = e^T P^-1 e (whitened by P's Cholesky factor).
+    """
+    q_t = np.asarray(q_true, dtype=float)
+    q_e = np.asarray(q_est, dtype=float)
+    errors = quaternions.to_rotation_vector(quaternions.multiply(q_e, quaternions.conjugate(q_t)))
+    chol = np.linalg.cholesky(np.asarray(covariances, dtype=float))
+    white = np.linalg.solve(chol, errors[..., None])[..., 0]
+    return errors, np.sum(white * white, axis=-1)
+
+
 def estimation(q_true, q_est, covariances, bias_true=None, bias_est=None, level=0.95):
     """
     Judge attitude estimates against the truth: errors, 3-sigma share, NEES and its verdict.
@@ -635,13 +651,7 @@ def estimation(q_true, q_est, covariances, bias_true=None, bias_est=None, level=
     if n < MIN_ESTIMATES:
         return EstimationFindings(OK, f'{n} estimates matched to the truth so far (needs '
                                       f'{MIN_ESTIMATES})', 'unavailable', samples=n)
-    q_t = np.asarray(q_true, dtype=float)
-    q_e = np.asarray(q_est, dtype=float)
-    errors = quaternions.to_rotation_vector(quaternions.multiply(q_e, quaternions.conjugate(q_t)))
-    cov = np.asarray(covariances, dtype=float)
-    chol = np.linalg.cholesky(cov)
-    white = np.linalg.solve(chol, errors[..., None])[..., 0]
-    nees_k = np.sum(white * white, axis=1)
+    errors, nees_k = attitude_nees(q_true, q_est, covariances)
     tau = autocorrelation_time(nees_k)
     independent = n / tau
     low = chi2.ppf((1.0 - level) / 2.0, 3.0 * independent) / independent
