@@ -4,7 +4,7 @@ The third-party modules that only some tools need, and the one-line error when o
 The nodes and the physics need numpy, scipy and the ROS messages only. The
 report needs matplotlib and plotly, the bag tools rosbags, an orbit from a TLE
 (``orbit_tle``) sgp4, the IGRF field ppigrf, the NRLMSIS density pymsis, a campaign on
-Dask Dask's distributed; a ROS
+Dask distributed; a ROS
 user who never runs them may not have them (plotly has no rosdep key, so ``rosdep install``
 cannot bring it). A tool calls :func:`require` first, before any work, and a
 missing module ends it with one line saying what to install and exit status 2,

@@ -15,7 +15,7 @@ import os
 import yaml
 
 from .dispersions import Dispersion
-from .scenario import CONTROL_SOURCES, check_scenario, NODES, node_values, READBACK
+from .scenario import check_scenario, CONTROL_SOURCES, node_values, NODES, READBACK
 from ..ros.parameters import ConfigurationError
 
 
@@ -30,20 +30,20 @@ class Key:
 
 #: The keys of a campaign file, in the manual's order.
 KEYS = (
-    Key('scenario', None, 'The nodes\' parameters, as a ROS 2 parameters file has them: '
+    Key('scenario', None, "The nodes' parameters, as a ROS 2 parameters file has them: "
         "sections ('/**', 'attitude_simulator', 'attitude_estimator', "
         "'attitude_controller') of 'ros__parameters:'. Or the path of such a file "
         '(relative to the campaign file): one file serves the nodes and the campaign.'),
     Key('runs', None, 'The number of runs (>= 2).'),
-    Key('seed', 0, 'The campaign\'s seed: with the run index and the parameter\'s name it '
-        'seeds every draw, so a run\'s values do not depend on the other runs.'),
+    Key('seed', 0, "The campaign's seed: with the run index and the parameter's name it "
+        "seeds every draw, so a run's values do not depend on the other runs."),
     Key('duration', None, 'Simulated time of each run (s), a whole number of the '
         "simulator's control_period."),
     Key('record_period', 1.0, 'Time between two recorded samples (s), a whole number of '
         'control periods; the ensemble is judged at these times.'),
     Key('judge_from', 0.0, 'Judge the estimator from this time on (s): the start-up '
         'transient is left out of the ANEES verdict.'),
-    Key('control_on', 'estimate', 'What the controller flies on: estimate (the MEKF\'s '
+    Key('control_on', 'estimate', "What the controller flies on: estimate (the MEKF's "
         'attitude and the gyro less the estimated bias), truth, or none (a free body).'),
     Key('dispersions', {}, 'Parameter name -> {distribution: normal | uniform | rotation | '
         'direction | seed, its keys, node: (optional) the one node it applies to}.'),
@@ -79,7 +79,7 @@ class Campaign:
 
 
 def _nominal(scenario, name, node):
-    """The scenario's value of ``name`` (for a dispersion's defaults), from the first node."""
+    """Return the scenario's value of ``name`` (a dispersion's default), from the first node."""
     for n in ([node] if node else NODES):
         if name in NODES[n].params:
             return node_values(scenario, n)[name]

@@ -30,12 +30,12 @@ class Ensemble:
 
     @property
     def flown(self):
-        """The records of the runs that flew."""
+        """Return the records of the runs that flew."""
         return [r for r in self.records if r['status'] == 'ok']
 
     @property
     def failed(self):
-        """The records of the runs that failed."""
+        """Return the records of the runs that failed."""
         return [r for r in self.records if r['status'] != 'ok']
 
 

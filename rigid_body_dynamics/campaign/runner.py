@@ -29,7 +29,7 @@ import numpy as np
 
 from .config import build
 from .dispersions import same_value
-from .scenario import NODES, node_values, pointing_errors, Run
+from .scenario import node_values, NODES, pointing_errors, READBACK, Run
 from ..optional import require
 from ..physics.analysis.motion import attitude_nees
 from ..ros.parameters import ConfigurationError
@@ -77,7 +77,6 @@ def run_one(job, index):
         run = _make_run(campaign, drawn)
         for (node, name), value in drawn.items():
             for n in ([node] if node else [n for n in NODES if name in NODES[n].params]):
-                from .scenario import READBACK
                 applied = READBACK[n][name](run)
                 applied = int(applied) if isinstance(value, int) else \
                     [float(c) for c in np.atleast_1d(applied)]

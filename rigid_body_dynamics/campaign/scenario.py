@@ -82,6 +82,8 @@ def check_scenario(scenario):
         if key not in known:
             raise ConfigurationError(f'scenario section {key!r} configures no node of a '
                                      f'campaign (sections: /**, {", ".join(NODES)})')
+    for node in NODES:
+        node_values(scenario, node)       # a node section's names are the node's
     shared = (scenario.get('/**') or {}).get('ros__parameters', {}) or {}
     declared = set().union(*(table.params for table in NODES.values()))
     unknown = sorted(set(shared) - declared)
@@ -207,7 +209,7 @@ def _sensor(run, name):
 
 
 def _tracker_noise(run):
-    """The estimator's star tracker sigmas (rad, tracker axes) from its covariance."""
+    """Return the estimator's star tracker sigmas (rad, tracker axes) from its covariance."""
     e = run.values['attitude_estimator']
     mount = np.asarray(quat.matrix(quat.normalize(np.asarray(e['star_tracker_orientation'],
                                                              dtype=float))))

@@ -148,7 +148,7 @@ class AttitudeEstimator(Node):
 
     @property
     def counts(self):
-        """Readings used per kind, gyro samples, late readings, gyro gaps and restarts."""
+        """Return the counts: readings used per kind, gyro samples, late, gaps, restarts."""
         return {**self.fusion.counts, **self._node_counts}
 
     # ---------------------------------------------------------------- intake

@@ -31,7 +31,7 @@ def main(argv=None):
                             'process, without Dask)')
     where.add_argument('--scheduler', help="a Dask scheduler's address, tcp://HOST:PORT")
     parser.add_argument('--output', help="the results' folder (default: the file's key, or "
-                                         "beside the file)")
+                                         'beside the file)')
     args = parser.parse_args(argv)
     if args.workers is not None and args.workers < 0:
         parser.error('--workers must be >= 0')
