@@ -9,7 +9,7 @@ Run the benchmarks and rewrite benchmarks/RESULTS.md.
 torque section alone (with ``--peers``: MuJoCo and Basilisk too); ``--only soak |
 soak-rt | flood | bodies | bodies-asymmetric | hosts | analyzer-memory | bag | lockstep |
 latency | publish | flow-batch | estimation | discovery | late-steps |
-bodies-wheels | fleet-check``
+bodies-wheels | fleet-check | campaign``
 runs one reliability / scale measurement (see each script).
 Sections from other benchmark scripts (nodes) are kept: each section sits
 between ``<!-- NAME -->`` and ``<!-- /NAME -->`` markers and only the sections
@@ -55,7 +55,7 @@ def main():
                                            'simulate-cost', 'wheels', 'wheels-node',
                                            'environment', 'environment-node', 'estimation',
                                            'discovery', 'late-steps', 'bodies-wheels',
-                                           'fleet-check', 'surface'],
+                                           'fleet-check', 'surface', 'campaign'],
                         help='run only this section')
     args = parser.parse_args()
     steps = 100_000 if args.quick else 1_000_000
@@ -127,6 +127,7 @@ SCALE = {
     'bodies-wheels': ('bodies_wheels', 'Many bodies with reaction wheels in fleets'),
     'late-steps': ('late_steps', 'Late steps in one fleet process, and what they waited for'),
     'fleet-check': ('fleet_check', '96 asymmetric bodies at the defaults, watched'),
+    'campaign': ('campaign', 'A Monte Carlo campaign of 1000 runs on Dask'),
 }
 
 

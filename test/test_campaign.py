@@ -20,7 +20,7 @@ import pytest
 from rigid_body_dynamics.campaign import build, gather, judge, run_campaign, run_one
 from rigid_body_dynamics.campaign.dispersions import Dispersion
 from rigid_body_dynamics.campaign.runner import job_of, load_record, run_path
-from rigid_body_dynamics.physics import presets, quaternions
+from rigid_body_dynamics.physics import quaternions
 from rigid_body_dynamics.physics.analysis import autocorrelation_time
 from rigid_body_dynamics.physics.analysis.ensemble import anees_bounds, false_failure_rate
 from rigid_body_dynamics.ros.parameters import ConfigurationError
@@ -207,11 +207,11 @@ def test_a_killed_campaign_runs_only_what_is_missing_and_gives_the_same_records(
 
 
 def _wait_for_file(path, proc, deadline):
+    """Wait until ``path`` exists (the scheduler wrote its address), polling the process."""
     import time
     while not os.path.exists(path):
         assert proc.poll() is None, 'the scheduler stopped'
         assert time.monotonic() < deadline, f'no {path}'
-        proc.wait_for = None
         try:
             proc.wait(timeout=0.1)
         except subprocess.TimeoutExpired:
@@ -236,6 +236,7 @@ def test_a_local_cluster_and_two_hosts_give_the_records_of_one_process(tmp_path)
     address_file = str(tmp_path / 'scheduler.json')
     procs = [subprocess.Popen([sys.executable, '-m', 'distributed.cli.dask_scheduler',
                                '--host', '127.0.0.1', '--port', '0', '--no-dashboard',
+                               '--dashboard-address', '127.0.0.1:0',
                                '--scheduler-file', address_file],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
     try:
@@ -244,7 +245,8 @@ def test_a_local_cluster_and_two_hosts_give_the_records_of_one_process(tmp_path)
             procs.append(subprocess.Popen(
                 [sys.executable, '-m', 'distributed.cli.dask_worker', '--scheduler-file',
                  address_file, '--nthreads', '1', '--nworkers', '1', '--host', '127.0.0.1',
-                 '--no-dashboard'], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+                 '--no-dashboard', '--dashboard-address', '127.0.0.1:0'],
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         with Client(scheduler_file=address_file, timeout=60) as client:
             client.wait_for_workers(2, timeout=120)
             address = client.scheduler.address
@@ -344,4 +346,3 @@ def test_rigid_body_campaign_runs_a_file_and_refuses_a_bad_one_in_one_line(tmp_p
                          capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and bad.stderr.count('\n') == 1, bad.stderr
     assert 'runs must be an integer >= 2' in bad.stderr
-    assert presets.get('tennis_racket')

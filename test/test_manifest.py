@@ -29,6 +29,7 @@ PYTHON_KEYS = {
     'matplotlib': 'python3-matplotlib',
     'rosbags': 'python3-rosbags-pip',
     'yaml': 'python3-yaml',
+    'pandas': 'python3-pandas',
     'pytest': 'python3-pytest',
     'hypothesis': 'python3-hypothesis',
     'mcap_ros2': 'mcap-ros2-support',
@@ -40,6 +41,8 @@ NO_KEY = {
     'sgp4': 'orbit_tle only; optional.require names it when missing (apt python3-sgp4)',
     'ppigrf': 'magnetic_field_model igrf only; optional.require names it when missing (pip)',
     'pymsis': 'atmosphere_model nrlmsis only; optional.require names it when missing (pip)',
+    'distributed': 'rigid_body_campaign on Dask only; optional.require names it when missing '
+                   '(apt python3-distributed)',
 }
 #: Declared, though no Python file imports them (and where they are used).
 NOT_IMPORTED = {

@@ -34,7 +34,8 @@ KEYS = (
         "sections ('/**', 'attitude_simulator', 'attitude_estimator', "
         "'attitude_controller') of 'ros__parameters:'. Or the path of such a file "
         '(relative to the campaign file): one file serves the nodes and the campaign.'),
-    Key('runs', None, 'The number of runs (>= 2).'),
+    Key('runs', None, 'The number of runs (>= 2). Raised later, only the new runs fly: a '
+        "run's record does not depend on how many there are."),
     Key('seed', 0, "The campaign's seed: with the run index and the parameter's name it "
         "seeds every draw, so a run's values do not depend on the other runs."),
     Key('duration', None, 'Simulated time of each run (s), a whole number of the '
@@ -45,8 +46,9 @@ KEYS = (
         'transient is left out of the ANEES verdict.'),
     Key('control_on', 'estimate', "What the controller flies on: estimate (the MEKF's "
         'attitude and the gyro less the estimated bias), truth, or none (a free body).'),
-    Key('dispersions', {}, 'Parameter name -> {distribution: normal | uniform | rotation | '
-        'direction | seed, its keys, node: (optional) the one node it applies to}.'),
+    Key('dispersions', {}, 'Parameter name -> {distribution: one of normal, uniform, '
+        'rotation, direction, seed; its keys; node: (optional) the one node it applies to, '
+        'else every node that declares the parameter}.'),
     Key('anees_level', 0.99, 'Two-sided confidence of the ANEES bounds at each time.'),
     Key('anees_min_share', 0.95, 'Share of times inside the bounds that a consistent '
         'verdict needs.'),
@@ -137,7 +139,10 @@ def build(values, base='.'):
                     'from the run to check that the drawn value took (give node: to '
                     'disperse it on another node only)')
         dispersions.append(d)
-    text = json.dumps({'values': values, 'scenario': scenario}, sort_keys=True, default=str)
+    # what a run's record depends on: not the number of runs (a campaign can grow) nor the
+    # folder it is stored in
+    kept = {k: val for k, val in values.items() if k not in ('runs', 'output')}
+    text = json.dumps({'values': kept, 'scenario': scenario}, sort_keys=True, default=str)
     digest = hashlib.sha256(text.encode()).hexdigest()[:16]
     return Campaign(v, scenario, dispersions, v['output'], digest)
 

@@ -121,6 +121,8 @@ def summary_lines(campaign, ens, judgement):
     lines = [f'campaign: {len(ens.flown)} of {len(ens.records)} runs flew, '
              f'{len(ens.failed)} failed',
              f'  estimator: {a.message}']
+    if campaign.control_on == 'none':
+        return lines
     final = {p: float(v[-1]) for p, v in judgement.pointing.items()}
     lines.append('  pointing error at the end: ' + ', '.join(
         f'p{p:g} {v:.3g} rad' for p, v in final.items()))

@@ -13,7 +13,8 @@ Where: ``workers=N`` starts a ``distributed.LocalCluster`` of N single-threaded
 worker processes on this machine (the default: one per core);
 ``scheduler='tcp://host:port'`` uses a running cluster's scheduler, whose workers
 must have this package installed; ``workers=0`` runs in this process without
-Dask (tests, debugging). Dask rather than Ray: Dask's distributed is pure
+Dask (tests, debugging). A LocalCluster listens on loopback only, its
+dashboard on a free port. Dask rather than Ray: Dask's distributed is pure
 Python, packaged by Debian and Ubuntu (python3-distributed), starts a
 LocalCluster in a second, and needs nothing but its scheduler's address to
 move to a cluster.
@@ -81,8 +82,7 @@ def run_one(job, index):
                 applied = int(applied) if isinstance(value, int) else \
                     [float(c) for c in np.atleast_1d(applied)]
                 record['applied'][f'{n}.{name}'] = applied
-                if not same_value(value, applied if isinstance(value, int) or
-                                  isinstance(value, list) else applied[0]):
+                if not same_value(value, applied[0] if isinstance(value, float) else applied):
                     raise DispersionNotApplied(
                         f'{name} on {n}: drew {value!r}, the run holds {applied!r}')
         flown = run.fly(campaign.duration, campaign.record_period)
@@ -146,7 +146,7 @@ def _prepare(campaign):
     if os.path.exists(manifest):
         with open(manifest, encoding='utf-8') as f:
             digest = json.load(f).get('digest')
-        if digest != campaign.digest:
+        if digest != campaign.digest:   # (the number of runs may differ: a campaign grows)
             raise ConfigurationError(
                 f'{out} holds the runs of another campaign (its configuration differs): give '
                 'another output, or remove the folder to start again')
@@ -224,7 +224,7 @@ def run_campaign(campaign, workers=None, scheduler=None, say=print):
     if scheduler is None:
         n = workers or os.cpu_count() or 1
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               host='127.0.0.1', dashboard_address=None)
+                               host='127.0.0.1', dashboard_address='127.0.0.1:0')
         client = Client(cluster)
         say(f'campaign: {len(todo)} runs on a local Dask cluster of {n} worker processes')
     else:

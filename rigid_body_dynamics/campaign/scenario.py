@@ -34,6 +34,8 @@ from ..ros.parameters import ConfigurationError
 #: The nodes a scenario configures, with their parameter tables.
 NODES = {'attitude_simulator': SIMULATOR, 'attitude_estimator': ESTIMATOR,
          'attitude_controller': CONTROLLER}
+#: The package's other nodes: their sections in a scenario are left alone (one file serves all).
+OTHER_NODES = ('attitude_analyzer', 'poinsot_visualizer', 'attitude_fleet')
 #: What the law flies on: the estimate (the MEKF's attitude and the gyro less its estimated
 #: bias), the truth, or nothing (a free body: the estimator alone).
 CONTROL_SOURCES = ('estimate', 'truth', 'none')
@@ -78,10 +80,12 @@ def check_scenario(scenario):
         raise ConfigurationError('scenario must be a parameters file: a mapping of sections '
                                  "(e.g. '/**') to 'ros__parameters:'")
     known = {key for node in NODES for key in _sections_of(node)}
+    others = {key for node in OTHER_NODES for key in _sections_of(node)}
     for key in scenario:
-        if key not in known:
-            raise ConfigurationError(f'scenario section {key!r} configures no node of a '
-                                     f'campaign (sections: /**, {", ".join(NODES)})')
+        if key not in known | others:
+            raise ConfigurationError(f'scenario section {key!r} configures no node (a campaign '
+                                     f'reads /**, {", ".join(NODES)}, and leaves '
+                                     f'{", ".join(OTHER_NODES)} alone)')
     for node in NODES:
         node_values(scenario, node)       # a node section's names are the node's
     shared = (scenario.get('/**') or {}).get('ros__parameters', {}) or {}

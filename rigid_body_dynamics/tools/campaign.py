@@ -2,7 +2,7 @@
 rigid_body_campaign: run a Monte Carlo campaign from its file; judge and tabulate it.
 
     rigid_body_campaign CONFIG.yaml [--workers N | --scheduler tcp://HOST:PORT]
-                                    [--output DIR]
+                                    [--runs N] [--output DIR]
 
 Runs the runs that have no record yet (a killed campaign started again goes on
 where it stopped), then writes runs.csv, ensemble.csv and report.html into the
@@ -30,6 +30,7 @@ def main(argv=None):
                        help='local worker processes (default: one per core; 0: in this '
                             'process, without Dask)')
     where.add_argument('--scheduler', help="a Dask scheduler's address, tcp://HOST:PORT")
+    parser.add_argument('--runs', type=int, help="the number of runs (instead of the file's)")
     parser.add_argument('--output', help="the results' folder (default: the file's key, or "
                                          'beside the file)')
     args = parser.parse_args(argv)
@@ -39,6 +40,10 @@ def main(argv=None):
         campaign = load(args.config)
         if args.output:
             campaign.output = os.path.abspath(args.output)
+        if args.runs is not None:
+            if args.runs < 2:
+                raise ConfigurationError(f'--runs must be >= 2, got {args.runs}')
+            campaign.values['runs'] = args.runs
         run_campaign(campaign, workers=args.workers, scheduler=args.scheduler)
         ens = gather(campaign.output)
         judgement = judge(campaign, ens)
