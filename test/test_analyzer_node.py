@@ -18,6 +18,7 @@ import pytest
 from rcl_interfaces.srv import SetParametersAtomically
 from rclpy.duration import Duration
 from rclpy.parameter import Parameter
+from rigid_body_dynamics.nodes.analyzer import SampleBuffer
 from rigid_body_dynamics.physics import FreeRigidBody, presets
 from rigid_body_dynamics.physics.analysis import theory
 from rigid_body_dynamics.ros.conversions import vector_msg
@@ -502,3 +503,27 @@ def test_node_processes_run_numpy_on_one_blas_thread_unless_told_otherwise(modul
         assert _threads_after(f'import numpy, rigid_body_dynamics.nodes.{module}', env) > ours
     _threads_after(f'{first}; assert os.environ["OPENBLAS_NUM_THREADS"] == "2"',
                    dict(env, OPENBLAS_NUM_THREADS='2'))
+
+
+def test_a_lost_bias_message_leaves_out_its_stamp_not_the_bias_finding():
+    """
+    Match 10 states, estimates and biases, one estimate's bias lost (best-effort input).
+
+    The attitudes are matched at all 10 stamps and the biases at the other 9; the
+    bias finding was dropped altogether for one lost message before.
+    """
+    buf = SampleBuffer()
+    for k in range(10):
+        t = k * 10 ** 8
+        buf.add(t, (0.0, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0), 10 ** 9, 10 ** 9)
+        buf.add_estimate(t, (0.0, 0.0, 0.0, 1.0), np.eye(3) * 1e-8)
+        buf.add_bias('true', t, (1e-3, 0.0, 0.0))
+        if k != 4:
+            buf.add_bias('estimate', t, (1e-3 + k * 1e-6, 0.0, 0.0))
+    q_true, q_est, cov, bias_true, bias_est = buf.estimate_arrays()
+    assert len(q_true) == len(q_est) == len(cov) == 10
+    assert bias_true.shape == bias_est.shape == (9, 3)
+    assert bias_est[:, 0].tolist() == [1e-3 + k * 1e-6 for k in range(10) if k != 4]
+    buf.bias['true'].clear()
+    assert buf.estimate_arrays()[3:] == (None, None)
+

@@ -235,16 +235,17 @@ class SampleBuffer:
         """
         Return (true q, estimated q, covariances, true bias, bias estimate) at common stamps.
 
-        The attitudes at the stamps both odom and the estimate have; the biases (N, 3)
-        where every one of those stamps has both, else None.
+        The attitudes at the stamps both odom and the estimate have; the biases (M, 3)
+        at those of the stamps that have both biases too, else None. The inputs are
+        best effort: a bias message lost under load leaves out its stamp, not the
+        bias finding (the bias error's RMS needs no alignment with the attitudes).
         """
         index = {t: i for i, t in enumerate(self.t)}
         rows = [(t, index[t], e) for t, e in zip(self.estimate_t, self.estimate) if t in index]
         true, estimate = self.bias['true'], self.bias['estimate']
-        biases = None, None
-        if rows and all(t in true and t in estimate for t, _, _ in rows):
-            biases = (np.array([true[t] for t, _, _ in rows]),
-                      np.array([estimate[t] for t, _, _ in rows]))
+        both = [t for t, _, _ in rows if t in true and t in estimate]
+        biases = (np.array([true[t] for t in both]), np.array([estimate[t] for t in both])) \
+            if both else (None, None)
         return (np.array([self.q[i] for _, i, _ in rows]).reshape(-1, 4),
                 np.array([e[0] for _, _, e in rows]).reshape(-1, 4),
                 np.array([e[1] for _, _, e in rows]).reshape(-1, 3, 3)) + biases

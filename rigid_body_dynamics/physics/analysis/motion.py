@@ -641,7 +641,8 @@ def estimation(q_true, q_est, covariances, bias_true=None, bias_est=None, level=
     share 1 - level of runs. "Inside 3 sigma": inside the ellipsoid of the
     covariance that holds 99.73 % (the share of 3 sigma in one dimension; for
     three dimensions chi-square(3) <= 14.16).
-    ``bias_true`` and ``bias_est`` (N, 3) rad/s add the bias error's RMS.
+    ``bias_true`` and ``bias_est`` (M, 3) rad/s, at M stamps of their own (the same for
+    both), add the bias error's RMS.
     Returns :class:`EstimationFindings`.
     """
     from scipy.stats import chi2
