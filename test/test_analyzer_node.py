@@ -526,4 +526,3 @@ def test_a_lost_bias_message_leaves_out_its_stamp_not_the_bias_finding():
     assert bias_est[:, 0].tolist() == [1e-3 + k * 1e-6 for k in range(10) if k != 4]
     buf.bias['true'].clear()
     assert buf.estimate_arrays()[3:] == (None, None)
-

@@ -15,7 +15,7 @@ import os
 import yaml
 
 from .dispersions import Dispersion
-from .scenario import check_scenario, CONTROL_SOURCES, node_values, NODES, READBACK
+from .scenario import check_scenario, CONTROL_SOURCES, node_values, NODES, nodes_of, READBACK
 from ..ros.parameters import ConfigurationError
 
 
@@ -132,7 +132,7 @@ def build(values, base='.'):
             raise ConfigurationError(f'dispersion of {name}: node must be one of '
                                      f'{", ".join(NODES)}, got {node!r}')
         d = Dispersion(name, spec, _nominal(scenario, name, node))
-        for n in ([node] if node else [n for n in NODES if name in NODES[n].params]):
+        for n in nodes_of(node, name):
             if name not in READBACK[n]:
                 raise ConfigurationError(
                     f'{name} cannot be dispersed on {n}: the campaign cannot read it back '

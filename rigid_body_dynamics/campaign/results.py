@@ -46,7 +46,7 @@ def gather(output):
     flown = [r for r in records if r['status'] == 'ok']
     arrays = {}
     if flown:
-        for key in ('q_true', 'q_estimate', 'covariance', 'errors', 'nees', 'pointing'):
+        for key in ('covariance', 'errors', 'nees', 'pointing'):
             arrays[key] = np.stack([r[key] for r in flown])
     return Ensemble(records, flown[0]['t'] if flown else np.zeros(0), arrays)
 

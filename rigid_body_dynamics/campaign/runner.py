@@ -30,7 +30,7 @@ import numpy as np
 
 from .config import build
 from .dispersions import same_value
-from .scenario import node_values, NODES, pointing_errors, READBACK, Run
+from .scenario import node_values, NODES, nodes_of, pointing_errors, READBACK, Run
 from ..optional import require
 from ..physics.analysis.motion import attitude_nees
 from ..ros.parameters import ConfigurationError
@@ -77,7 +77,7 @@ def run_one(job, index):
     try:
         run = _make_run(campaign, drawn)
         for (node, name), value in drawn.items():
-            for n in ([node] if node else [n for n in NODES if name in NODES[n].params]):
+            for n in nodes_of(node, name):
                 applied = READBACK[n][name](run)
                 applied = int(applied) if isinstance(value, int) else \
                     [float(c) for c in np.atleast_1d(applied)]
@@ -105,7 +105,7 @@ def _make_run(campaign, drawn):
     """Return the Run of the scenario with run's drawn values in place."""
     extra = {n: {} for n in NODES}
     for (node, name), value in drawn.items():
-        for n in ([node] if node else NODES):
+        for n in nodes_of(node, name):
             extra[n][name] = value
     extra['attitude_simulator']['lockstep'] = True
     values = {n: NODES[n].validate(node_values(campaign.scenario, n, extra[n])) for n in NODES}
@@ -221,6 +221,9 @@ def run_campaign(campaign, workers=None, scheduler=None, say=print):
     require('distributed')
     from distributed import as_completed, Client, LocalCluster
     cluster = None
+    # a LocalCluster sets its workers' environment (OMP_NUM_THREADS, PYTHONHASHSEED, ...) in
+    # this process's os.environ: the caller's is put back afterwards
+    environment = dict(os.environ)
     if scheduler is None:
         n = workers or os.cpu_count() or 1
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
@@ -249,4 +252,6 @@ def run_campaign(campaign, workers=None, scheduler=None, say=print):
         client.close()
         if cluster is not None:
             cluster.close()
+        os.environ.clear()
+        os.environ.update(environment)
     return len(todo)

@@ -18,17 +18,14 @@ the wall clock, so a run's result is a function of its values, bit for bit,
 whichever process runs it.
 """
 
-import math
 
 import numpy as np
 
 from ..engine import TorqueCommands
-from ..nodes.controller import PARAMETERS as CONTROLLER
-from ..nodes.estimator import PARAMETERS as ESTIMATOR
+from ..nodes.controller import law_from, PARAMETERS as CONTROLLER
+from ..nodes.estimator import fusion_from, PARAMETERS as ESTIMATOR
 from ..nodes.simulator_parameters import body_from, PARAMETERS as SIMULATOR
 from ..physics import quaternions as quat
-from ..physics.control import QuaternionPD, RateDamper
-from ..physics.mekf_fusion import MekfFusion
 from ..ros.parameters import ConfigurationError
 
 #: The nodes a scenario configures, with their parameter tables.
@@ -45,6 +42,11 @@ MODES = ('slew', 'detumble')
 
 def _sections_of(node):
     return ('/**', f'/**/{node}', node, f'/{node}')
+
+
+def nodes_of(node, name):
+    """Return the nodes a dispersion of ``name`` applies to: ``node``, or every declaring one."""
+    return [node] if node else [n for n in NODES if name in NODES[n].params]
 
 
 def node_values(scenario, node, extra=None):
@@ -121,18 +123,10 @@ class Run:
         if not self.body.every('gyro') or not self.body.every('star_tracker'):
             raise ConfigurationError('the estimator needs the gyro (publish_imu) and the star '
                                      'tracker (star_tracker_rate > 0) of the simulator')
-        e = estimator
-        self.fusion = MekfFusion(
-            e['gyro_noise_density'], e['gyro_bias_random_walk'], e['tracker_covariance'],
-            e['initial_bias_sigma'] or e['gyro_turn_on_bias'], sun=e['sun'],
-            sun_noise=e['sun_sensor_noise'], field=e['field'], orbit=e['orbit'],
-            magnetometer_noise=e['magnetometer_noise'])
-        c = controller
+        self.fusion = fusion_from(estimator)
+        # the law as attitude_controller makes it, from the inertia tensor's diagonal
         moments = tuple(float(m) for m in np.diag(self.body.inertia.tensor))
-        self.law = None if control_on == 'none' else (
-            QuaternionPD(moments, c['target_orientation'], c['natural_frequency'],
-                         c['damping_ratio'], c['max_torque']) if c['mode'] == 'slew' else
-            RateDamper(moments, c['natural_frequency'], c['damping_ratio'], c['max_torque']))
+        self.law = None if control_on == 'none' else law_from(controller, moments)
 
     def fly(self, duration, record_period):
         """
@@ -254,6 +248,5 @@ READBACK = {
 
 def pointing_errors(q_true, target):
     """Return the angle (N,; rad) between each attitude q_true (N, 4) and ``target`` (4,)."""
-    target = np.asarray(target, dtype=float) / math.sqrt(sum(c * c for c in target))
-    dots = np.abs(np.asarray(q_true) @ target)
-    return 2.0 * np.arccos(np.clip(dots, 0.0, 1.0))
+    target = np.asarray(target, dtype=float)
+    return quat.angle_between(target / np.linalg.norm(target), np.asarray(q_true, dtype=float))

@@ -94,6 +94,22 @@ def _allocator(values, out):
 
 
 #: The parameters of attitude_controller (the manual's table is made from this; test_docs checks).
+def law_from(values, moments):
+    """
+    Return the law of validated ``values``: QuaternionPD (slew), RateDamper or BDot.
+
+    ``moments``: the body axes' moments (kg m^2; the inertia tensor's diagonal, as
+    the inertia topic gives it); not used by bdot.
+    """
+    v = values
+    if v['mode'] == 'bdot':
+        return BDot(v['bdot_gain'], v['magnetorquer_max_dipole'])
+    if v['mode'] == 'detumble':
+        return RateDamper(moments, v['natural_frequency'], v['damping_ratio'], v['max_torque'])
+    return QuaternionPD(moments, v['target_orientation'], v['natural_frequency'],
+                        v['damping_ratio'], v['max_torque'])
+
+
 PARAMETERS = ParameterTable([
     Param('mode', 'string', 'slew', '`slew`',
           'slew: quaternion PD to target_orientation; detumble: rate damping only; bdot: '
@@ -189,17 +205,8 @@ class AttitudeController(Node):
     def _rebuild(self):
         """Make the law from the values and the inertia (call under the lock)."""
         v = self._values
-        if v['mode'] == 'bdot':
-            self._law = BDot(v['bdot_gain'], v['magnetorquer_max_dipole'])
-        elif self._moments is None:
-            self._law = None
-        elif v['mode'] == 'detumble':
-            self._law = RateDamper(self._moments, v['natural_frequency'], v['damping_ratio'],
-                                   v['max_torque'])
-        else:
-            self._law = QuaternionPD(self._moments, v['target_orientation'],
-                                     v['natural_frequency'], v['damping_ratio'],
-                                     v['max_torque'])
+        self._law = None if self._moments is None and v['mode'] != 'bdot' else \
+            law_from(v, self._moments)
 
     def _on_inertia(self, msg):
         if self._bdot:          # B-dot needs no inertia; a new law would forget its last reading

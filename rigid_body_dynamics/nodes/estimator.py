@@ -92,6 +92,16 @@ PARAMETERS = ParameterTable([
 ], cross_checks=(_models,))
 
 
+def fusion_from(values):
+    """Return the MekfFusion of attitude_estimator's validated ``values`` (PARAMETERS)."""
+    v = values
+    return MekfFusion(
+        v['gyro_noise_density'], v['gyro_bias_random_walk'], v['tracker_covariance'],
+        v['initial_bias_sigma'] or v['gyro_turn_on_bias'], sun=v['sun'],
+        sun_noise=v['sun_sensor_noise'], field=v['field'], orbit=v['orbit'],
+        magnetometer_noise=v['magnetometer_noise'])
+
+
 #: A gyro interval longer than this times the shortest one seen is a gap: readings lost.
 GAP = 1.5
 #: Diagnostic value names of the counters that are not messages used.
@@ -106,11 +116,7 @@ class AttitudeEstimator(Node):
         super().__init__(NODE_NAME, **kwargs)
         v = self._values = PARAMETERS.validate(PARAMETERS.declare(self))
         self._world, self._body = v['world_frame'], v['body_frame']
-        self.fusion = MekfFusion(
-            v['gyro_noise_density'], v['gyro_bias_random_walk'], v['tracker_covariance'],
-            v['initial_bias_sigma'] or v['gyro_turn_on_bias'], sun=v['sun'],
-            sun_noise=v['sun_sensor_noise'], field=v['field'], orbit=v['orbit'],
-            magnetometer_noise=v['magnetometer_noise'])
+        self.fusion = fusion_from(v)
         self._pending = []            # heap of (stamp ns, kind order, sequence, kind, data)
         self._sequence = 0
         # the fusion counts the readings it takes; the node counts gaps and restarts
@@ -201,8 +207,7 @@ class AttitudeEstimator(Node):
             self.get_logger().warning(
                 f'gyro readings missing: {interval * 1e-6:.3g} ms between two where '
                 f'{shortest * 1e-6:.3g} ms is usual ({self._node_counts["gyro gaps"]} gaps so '
-                'far); '
-                'the estimate holds the rate across them and is worse than it says (a busy '
+                'far); the estimate holds the rate across them and is worse than it says (a busy '
                 'machine? a deeper queue: qos_overrides./imu.subscription.depth)',
                 throttle_duration_sec=5.0)
 
